@@ -1,0 +1,16 @@
+//! `cargo bench`: the standard scene through `pdq::bench` (the same code as `pdq bench`).
+
+fn main() {
+    let opts = pdq::bench::BenchOptions {
+        model: "pmb".into(),
+        threads: 1,
+        steps: 100,
+        n: 40,
+        peer: false,
+        repeat: 5,
+    };
+    match pdq::bench::run(&opts) {
+        Ok(s) => print!("{s}"),
+        Err(e) => eprintln!("bench failed: {e}"),
+    }
+}

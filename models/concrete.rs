@@ -1,0 +1,289 @@
+//! The thesis's reinforced-concrete model (Sakhavand 2011, appendix A `ConcConc`; THEORY.md §8).
+//!
+//! * concrete–concrete: f = E′·s between the compressive and tensile critical stretches
+//!   s_c < s < s_t, E′ = 6E/(πδ⁴(1−2ν)) (thesis eq. 4.1); outside that range the bond breaks for
+//!   good (the thesis code re-formed it when the stretch came back, the defect not repeated here);
+//! * steel–steel: elastic to the yield stretch, then perfectly plastic in stretch, with the
+//!   plastic stretch kept as bond history, until |s| exceeds the failure stretch;
+//! * concrete–steel: the concrete law with its force and both critical stretches multiplied by
+//!   `interface_factor` (default 3, the EMU manual's advice).
+//!
+//! Two different concrete (or steel) materials bond with the series stiffness and the tighter
+//! limits.
+
+use crate::model::{check_options, stretch, BondGeom, MaterialKind, Model, ModelBuild, Side};
+use std::f64::consts::PI;
+
+pub use super::pmb::{Force3, Motion};
+
+crate::attributes! {
+    /// Plastic part of the bond stretch (steel bonds only; zero elsewhere).
+    pub struct PlasticStretch { pub plastic_stretch: f64 }
+}
+
+/// The law of one pair of materials.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Law {
+    /// Linear between `compressive` (< 0) and `tensile` (> 0) stretch, broken outside.
+    Brittle {
+        c: f64,
+        tensile: f64,
+        compressive: f64,
+    },
+    /// Elastic–perfectly plastic in stretch, failing beyond `failure`.
+    Plastic { c: f64, yield_: f64, failure: f64 },
+}
+
+impl Law {
+    fn stiffness(&self) -> f64 {
+        match *self {
+            Law::Brittle { c, .. } | Law::Plastic { c, .. } => c,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Concrete {
+    laws: Vec<Law>,
+    n: usize,
+    density: Vec<f64>,
+}
+
+impl Concrete {
+    #[inline(always)]
+    fn law(&self, a: u16, b: u16) -> Law {
+        self.laws[a as usize * self.n + b as usize]
+    }
+
+    pub fn law_of(&self, a: u16, b: u16) -> Law {
+        self.law(a, b)
+    }
+
+    /// Force coefficient (before volumes and β) and whether the bond survives.
+    #[inline(always)]
+    fn coefficient(law: Law, s: f64, plastic: &mut f64) -> Option<f64> {
+        match law {
+            Law::Brittle {
+                c,
+                tensile,
+                compressive,
+            } => {
+                if s > tensile || s < compressive {
+                    None
+                } else {
+                    Some(c * s)
+                }
+            }
+            Law::Plastic { c, yield_, failure } => {
+                if s.abs() > failure {
+                    return None;
+                }
+                let elastic = s - *plastic;
+                if elastic > yield_ {
+                    *plastic = s - yield_;
+                } else if elastic < -yield_ {
+                    *plastic = s + yield_;
+                }
+                Some(c * (s - *plastic))
+            }
+        }
+    }
+}
+
+/// The bond micromodulus of the thesis (eq. 4.1).
+pub fn thesis_micromodulus(e: f64, nu: f64, delta: f64) -> f64 {
+    6.0 * e / (PI * delta.powi(4) * (1.0 - 2.0 * nu))
+}
+
+impl Model for Concrete {
+    const NAME: &'static str = "concrete";
+    const SUMMARY: &'static str =
+        "thesis reinforced-concrete bonds: brittle concrete (s_c < s < s_t), elastic-plastic steel, x3 interface";
+    const OPTIONS: &'static [(&'static str, &'static str)] = &[(
+        "interface_factor",
+        "concrete-steel bonds: multiplier on force and critical stretches (default 3)",
+    )];
+
+    type Alter = Motion;
+    type Fixed = ();
+    type Bond = PlasticStretch;
+    type State = ();
+    type Force = Force3;
+
+    fn build(b: &ModelBuild) -> Result<Self, String> {
+        check_options(Self::NAME, Self::OPTIONS, b.options)?;
+        let factor = b.option("interface_factor").unwrap_or(3.0);
+        if !(factor > 0.0) {
+            return Err("model option 'interface_factor' must be > 0".into());
+        }
+        let mut own = Vec::new();
+        for m in b.materials {
+            let e = m.require(m.youngs_modulus, "youngs_modulus", Self::NAME)?;
+            let nu = m.require(m.poisson_ratio, "poisson_ratio", Self::NAME)?;
+            if !(nu > -1.0 && nu < 0.5) {
+                return Err(format!(
+                    "material '{}': poisson_ratio must lie in (-1, 0.5), got {nu}",
+                    m.name
+                ));
+            }
+            let c = thesis_micromodulus(e, nu, b.horizon);
+            let law = match m.kind {
+                MaterialKind::Concrete => {
+                    let tensile = m.require(m.tensile_stretch, "tensile_stretch", Self::NAME)?;
+                    let compressive =
+                        m.require(m.compressive_stretch, "compressive_stretch", Self::NAME)?;
+                    if !(tensile > 0.0 && compressive < 0.0) {
+                        return Err(format!(
+                            "material '{}': need tensile_stretch > 0 and compressive_stretch < 0",
+                            m.name
+                        ));
+                    }
+                    Law::Brittle {
+                        c,
+                        tensile,
+                        compressive,
+                    }
+                }
+                MaterialKind::Steel => {
+                    let yield_ = m.require(m.yield_stretch, "yield_stretch", Self::NAME)?;
+                    let failure = m.failure_stretch.unwrap_or(f64::INFINITY);
+                    if !(yield_ > 0.0 && failure > yield_) {
+                        return Err(format!(
+                            "material '{}': need 0 < yield_stretch < failure_stretch",
+                            m.name
+                        ));
+                    }
+                    Law::Plastic {
+                        c,
+                        yield_,
+                        failure,
+                    }
+                }
+                MaterialKind::Solid => {
+                    return Err(format!(
+                        "material '{}' has kind 'solid'; model 'concrete' takes kind = \"concrete\" or \"steel\"",
+                        m.name
+                    ))
+                }
+            };
+            own.push(law);
+        }
+        let n = own.len();
+        let mut laws = Vec::with_capacity(n * n);
+        for a in &own {
+            for b in &own {
+                laws.push(combine(*a, *b, factor));
+            }
+        }
+        Ok(Concrete {
+            laws,
+            n,
+            density: b.materials.iter().map(|m| m.density).collect(),
+        })
+    }
+
+    fn inertia(&self, material: u16, volume: f64, _fixed: &()) -> Force3 {
+        let m = self.density[material as usize] * volume;
+        Force3 { force: [m; 3] }
+    }
+
+    fn bond_stiffness(&self, mi: u16, mj: u16, geom: &BondGeom) -> f64 {
+        self.law(mi, mj).stiffness() / geom.length
+    }
+
+    #[inline(always)]
+    fn pair(
+        &self,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+        bond: &mut PlasticStretch,
+    ) -> Option<(Force3, Force3)> {
+        let (s, y, r) = stretch(i, j, geom);
+        let c = Self::coefficient(
+            self.law(i.material, j.material),
+            s,
+            &mut bond.plastic_stretch,
+        )?;
+        let f = c * geom.beta * i.volume * j.volume / r;
+        let fi = [f * y[0], f * y[1], f * y[2]];
+        Some((
+            Force3 { force: fi },
+            Force3 {
+                force: [-fi[0], -fi[1], -fi[2]],
+            },
+        ))
+    }
+
+    fn energy(
+        &self,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+        bond: &PlasticStretch,
+    ) -> f64 {
+        let (s, _, _) = stretch(i, j, geom);
+        let elastic = s - bond.plastic_stretch;
+        let c = self.law(i.material, j.material).stiffness();
+        0.5 * c * elastic * elastic * geom.length * geom.beta * i.volume * j.volume
+    }
+}
+
+/// The law between two materials' own laws.
+fn combine(a: Law, b: Law, factor: f64) -> Law {
+    let series = |x: f64, y: f64| 2.0 * x * y / (x + y);
+    match (a, b) {
+        (
+            Law::Brittle {
+                c: ca,
+                tensile: ta,
+                compressive: pa,
+            },
+            Law::Brittle {
+                c: cb,
+                tensile: tb,
+                compressive: pb,
+            },
+        ) => Law::Brittle {
+            c: series(ca, cb),
+            tensile: ta.min(tb),
+            compressive: pa.max(pb),
+        },
+        (
+            Law::Plastic {
+                c: ca,
+                yield_: ya,
+                failure: fa,
+            },
+            Law::Plastic {
+                c: cb,
+                yield_: yb,
+                failure: fb,
+            },
+        ) => Law::Plastic {
+            c: series(ca, cb),
+            yield_: ya.min(yb),
+            failure: fa.min(fb),
+        },
+        (
+            Law::Brittle {
+                c,
+                tensile,
+                compressive,
+            },
+            Law::Plastic { .. },
+        )
+        | (
+            Law::Plastic { .. },
+            Law::Brittle {
+                c,
+                tensile,
+                compressive,
+            },
+        ) => Law::Brittle {
+            c: c * factor,
+            tensile: tensile * factor,
+            compressive: compressive * factor,
+        },
+    }
+}

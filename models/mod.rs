@@ -1,0 +1,12 @@
+//! The models a deck can name. Each file holds the physics of one model and nothing else.
+//!
+//! Adding a model: write `models/<name>.rs` implementing [`crate::model::Model`] and add its
+//! type to the list below. `cargo build` is the whole workflow.
+
+pub mod concrete;
+pub mod pmb;
+
+crate::model_registry! {
+    pmb::Pmb,
+    concrete::Concrete,
+}

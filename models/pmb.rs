@@ -1,0 +1,170 @@
+//! PMB: Silling's prototype microelastic brittle model (Silling 2000; Silling & Askari 2005).
+//!
+//! f_ij = c·s·β·V_i·V_j along the current bond, c = 18K/(πδ⁴) (ν = ¼ is implied), and the bond
+//! breaks for good once s > s0, with s0 given or from the fracture energy: s0 = √(5G0/(9Kδ)).
+//! THEORY.md §1. A bond between two materials takes the series stiffness 2c_a c_b/(c_a + c_b)
+//! and the smaller critical stretch.
+
+use crate::model::{check_options, stretch, BondGeom, Model, ModelBuild, Side};
+use std::f64::consts::PI;
+
+crate::attributes! {
+    /// Current position and velocity.
+    pub struct Motion { pub pos: [f64; 3], pub vel: [f64; 3] }
+}
+
+crate::attributes! {
+    /// Force on the three translational degrees of freedom.
+    pub struct Force3 { pub force: [f64; 3] }
+}
+
+/// Micromodulus and critical stretch of one pair of materials.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Law {
+    pub c: f64,
+    pub s0: f64,
+}
+
+#[derive(Clone, Debug)]
+pub struct Pmb {
+    /// `laws[a * n + b]` for materials a, b.
+    laws: Vec<Law>,
+    n: usize,
+    density: Vec<f64>,
+}
+
+impl Pmb {
+    #[inline(always)]
+    fn law(&self, a: u16, b: u16) -> Law {
+        if self.n == 1 {
+            self.laws[0]
+        } else {
+            self.laws[a as usize * self.n + b as usize]
+        }
+    }
+
+    pub fn laws(&self) -> &[Law] {
+        &self.laws
+    }
+}
+
+impl Model for Pmb {
+    const NAME: &'static str = "pmb";
+    const SUMMARY: &'static str =
+        "bond-based prototype microelastic brittle solid (Silling), nu = 1/4, critical stretch";
+
+    type Alter = Motion;
+    type Fixed = ();
+    type Bond = ();
+    type State = ();
+    type Force = Force3;
+
+    fn build(b: &ModelBuild) -> Result<Self, String> {
+        check_options(Self::NAME, Self::OPTIONS, b.options)?;
+        let delta = b.horizon;
+        let mut own = Vec::new();
+        for m in b.materials {
+            let c = match (m.micromodulus, m.bulk_modulus, m.youngs_modulus) {
+                (Some(c), _, _) => c,
+                (None, Some(k), _) => 18.0 * k / (PI * delta.powi(4)),
+                // ν = 1/4 is built into bond-based PMB: K = 2E/3.
+                (None, None, Some(e)) => 12.0 * e / (PI * delta.powi(4)),
+                _ => {
+                    return Err(format!(
+                        "material '{}' needs 'bulk_modulus', 'youngs_modulus' or 'micromodulus' for model 'pmb'",
+                        m.name
+                    ))
+                }
+            };
+            if let Some(nu) = m.poisson_ratio {
+                if (nu - 0.25).abs() > 1e-9 {
+                    return Err(format!(
+                        "material '{}': bond-based PMB has Poisson's ratio 1/4, the deck gives {nu}; use model 'lps' (state-based) for other values or remove 'poisson_ratio'",
+                        m.name
+                    ));
+                }
+            }
+            if !(c.is_finite() && c > 0.0) {
+                return Err(format!("material '{}': micromodulus must be > 0", m.name));
+            }
+            let s0 = match (m.critical_stretch, m.fracture_energy) {
+                (Some(s0), None) => s0,
+                (None, Some(g0)) => {
+                    // s0 = sqrt(10 G0 / (π c δ⁵)), equal to sqrt(5G0/(9Kδ)) with c = 18K/(πδ⁴).
+                    (10.0 * g0 / (PI * c * delta.powi(5))).sqrt()
+                }
+                (None, None) => f64::INFINITY,
+                (Some(_), Some(_)) => {
+                    return Err(format!(
+                        "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
+                        m.name
+                    ))
+                }
+            };
+            if !(s0 > 0.0) {
+                return Err(format!(
+                    "material '{}': critical stretch must be > 0",
+                    m.name
+                ));
+            }
+            own.push(Law { c, s0 });
+        }
+        let n = own.len();
+        let mut laws = Vec::with_capacity(n * n);
+        for a in &own {
+            for b in &own {
+                laws.push(Law {
+                    c: 2.0 * a.c * b.c / (a.c + b.c),
+                    s0: a.s0.min(b.s0),
+                });
+            }
+        }
+        Ok(Pmb {
+            laws,
+            n,
+            density: b.materials.iter().map(|m| m.density).collect(),
+        })
+    }
+
+    fn inertia(&self, material: u16, volume: f64, _fixed: &()) -> Force3 {
+        let m = self.density[material as usize] * volume;
+        Force3 { force: [m; 3] }
+    }
+
+    fn bond_stiffness(&self, mi: u16, mj: u16, geom: &BondGeom) -> f64 {
+        self.law(mi, mj).c / geom.length
+    }
+
+    #[inline(always)]
+    fn pair(
+        &self,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+        _bond: &mut (),
+    ) -> Option<(Force3, Force3)> {
+        let law = self.law(i.material, j.material);
+        let (a, b) = (i.pos(), j.pos());
+        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+        // s = e/L; comparing e with s0·L and folding 1/L into 1/r leaves one division per bond.
+        let e = r - geom.length;
+        if e > law.s0 * geom.length {
+            return None;
+        }
+        let f = law.c * geom.beta * i.volume * j.volume * e / (geom.length * r);
+        let fi = [f * y[0], f * y[1], f * y[2]];
+        Some((
+            Force3 { force: fi },
+            Force3 {
+                force: [-fi[0], -fi[1], -fi[2]],
+            },
+        ))
+    }
+
+    fn energy(&self, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _bond: &()) -> f64 {
+        let law = self.law(i.material, j.material);
+        let (s, _, _) = stretch(i, j, geom);
+        0.5 * law.c * s * s * geom.length * geom.beta * i.volume * j.volume
+    }
+}

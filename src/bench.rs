@@ -1,0 +1,288 @@
+//! `pdq bench`: the standard scene of `shared/bench` (a (n+1)³ simple-cubic lattice, spacing
+//! 1 mm, horizon 3.015 mm, top three layers moving up at 1 m/s, Δt = 1e-7 s, free boundaries),
+//! timed through the same deck → setup → step path as a user's run, the LAMMPS peer on the same
+//! scene when asked, and a hand-specialized PMB force loop kept here only as a yardstick for
+//! what the generic model path costs.
+
+use crate::deck;
+use crate::forces;
+use crate::model::{Model, ModelVisitor};
+use crate::models::pmb::{Motion, Pmb};
+use crate::setup;
+use std::fmt::Write as _;
+use std::process::Command;
+use std::time::Instant;
+
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    pub model: String,
+    pub threads: usize,
+    pub steps: u64,
+    /// Lattice cells per edge: (n + 1)³ particles; 40 is the standard scene.
+    pub n: usize,
+    pub peer: bool,
+    /// Repetitions of the yardstick comparison (medians are reported).
+    pub repeat: usize,
+}
+
+const SPACING: f64 = 0.001;
+
+/// The standard scene as a deck, for `model` ("pmb" or "concrete").
+pub fn standard_deck(model: &str, n: usize, steps: u64) -> Result<String, String> {
+    let h = SPACING;
+    let hi = (n as f64 + 0.5) * h;
+    let material = match model {
+        "pmb" => {
+            "density = 2200\nmicromodulus = 1.6863e22\ncritical_stretch = 0.0005\n".to_string()
+        }
+        // The same stiffness through the thesis's E′ = 6E/(πδ⁴(1−2ν)) at ν = 0.25, with the
+        // benchmark's critical stretch in tension and 10x in compression.
+        "concrete" => {
+            let e = 1.6863e22 * std::f64::consts::PI * 0.003015f64.powi(4) * 0.5 / 6.0;
+            format!("kind = \"concrete\"\ndensity = 2200\nyoungs_modulus = {e:e}\npoisson_ratio = 0.25\ntensile_stretch = 0.0005\ncompressive_stretch = -0.005\n")
+        }
+        other => {
+            return Err(format!(
+                "no standard bench scene for model '{other}' (use pmb or concrete)"
+            ))
+        }
+    };
+    Ok(format!(
+        r#"title = "standard benchmark scene ({model})"
+units = "SI"
+[model]
+name = "{model}"
+horizon = 0.003015
+[lattice]
+spacing = {h:e}
+origin = [{o:e}, {o:e}, {o:e}]
+[materials.solid]
+{material}
+[[geometry]]
+shape = "box"
+material = "solid"
+min = [{o:e}, {o:e}, {o:e}]
+max = [{hi:e}, {hi:e}, {hi:e}]
+[time]
+steps = {steps}
+dt = 1e-7
+force_dt = true
+[[initial]]
+region = {{ shape = "slab", axis = "z", from = {top:e}, to = 1.0 }}
+velocity = [0, 0, 1]
+[output]
+progress = false
+history_every = {steps}
+"#,
+        o = -0.5 * h,
+        top = (n as f64 - 2.5) * h,
+    ))
+}
+
+/// The LAMMPS input of the peer benchmark (`shared/bench/lammps_pmb.in`).
+const LAMMPS_PMB: &str = "units si\nboundary s s s\natom_style peri\natom_modify map array\nlattice sc 0.001\nregion box block 0 ${n} 0 ${n} 0 ${n}\ncreate_box 1 box\ncreate_atoms 1 region box\npair_style peri/pmb\npair_coeff * * 1.6863e22 0.0030150 0.0005 0.25\nset group all density 2200\nset group all volume 1.0e-9\nvelocity all set 0.0 0.0 0.0 sum no units box\nregion top block INF INF INF INF $(v_n-2) ${n} units lattice\ngroup top region top\nvelocity top set 0.0 0.0 1.0 sum no units box\nneighbor 0.0010 bin\nfix 1 all nve\ntimestep 1.0e-7\nthermo 100\nrun ${steps}\n";
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+/// Runs the benchmark and returns the lines it printed.
+pub fn run(opts: &BenchOptions) -> Result<String, String> {
+    if opts.threads != 1 {
+        return Err(format!(
+            "threads = {}: this build runs one procCube per process; multi-threaded procCubes come with the wall-method decomposition",
+            opts.threads
+        ));
+    }
+    let text = standard_deck(&opts.model, opts.n, opts.steps)?;
+    let scene = deck::parse(&text, "<bench>", "bench").map_err(|e| e.to_string())?;
+    struct Visit<'a>(&'a deck::Scene, &'a BenchOptions);
+    impl ModelVisitor for Visit<'_> {
+        type Output = Result<String, String>;
+        fn visit<M: Model>(self, model: M) -> Self::Output {
+            let setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
+            bench_setup(setup, self.1)
+        }
+    }
+    let mut out = setup::with_model(&scene, Visit(&scene, opts)).map_err(|e| e.to_string())??;
+    if opts.peer {
+        out.push_str(&peer(opts)?);
+    }
+    Ok(out)
+}
+
+fn bench_setup<M: Model>(
+    mut setup: setup::Setup<M>,
+    opts: &BenchOptions,
+) -> Result<String, String> {
+    let sim = &mut setup.sim;
+    let n = sim.particles.n_owned;
+    let bonds = sim.bonds.len();
+    let t = Instant::now();
+    for _ in 0..opts.steps {
+        sim.advance();
+    }
+    let secs = t.elapsed().as_secs_f64();
+    let ps = (n as u64 * opts.steps) as f64;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "bench model={} particles={n} steps={} threads={} ranks=1 us_per_particle_step={:.4} ns_per_bond={:.3} bonds={bonds} broken={} seconds={:.3}",
+        M::NAME,
+        opts.steps,
+        opts.threads,
+        1e6 * secs / ps,
+        1e9 * secs / (bonds as f64 * opts.steps as f64),
+        sim.bonds.broken_count(),
+        secs
+    );
+    for line in sim.timing.table(0.0).lines() {
+        let _ = writeln!(out, "# {line}");
+    }
+    // The yardstick: the generic pair pass against a hand-written PMB loop on the same state.
+    if let Some(pmb) = (&sim.model as &dyn std::any::Any).downcast_ref::<Pmb>() {
+        let law = pmb.laws()[0];
+        let (mut generic, mut hand) = (Vec::new(), Vec::new());
+        let (mut same, mut same_broken) = (true, true);
+        for _ in 0..opts.repeat.max(1) {
+            let mut bonds_copy = sim.bonds.broken.clone();
+            let (mut f, ts) = {
+                let alter: &[Motion] =
+                    bytemuck::cast_slice(bytemuck::cast_slice::<_, f64>(&sim.particles.alter));
+                let t = Instant::now();
+                let f = hand_pmb_pass(
+                    alter,
+                    &sim.particles.volume,
+                    sim.bonds.offsets(),
+                    sim.bonds.partners(),
+                    &sim.bonds.geom,
+                    &mut bonds_copy,
+                    law.c,
+                    law.s0,
+                );
+                (f, t.elapsed().as_secs_f64())
+            };
+            hand.push(ts);
+            // The generic pass works on copies so both see the same state.
+            let saved = sim.bonds.broken.clone();
+            let t = Instant::now();
+            forces::pair_pass(&sim.model, &mut sim.particles, &mut sim.bonds);
+            generic.push(t.elapsed().as_secs_f64());
+            let g: &[f64] = bytemuck::cast_slice(&sim.particles.force);
+            for (a, b) in g.chunks(3).zip(f.iter_mut()) {
+                same &= a == &b[..];
+            }
+            same_broken &= sim.bonds.broken == bonds_copy;
+            sim.bonds.broken = saved;
+        }
+        let (g, h) = (median(generic), median(hand));
+        let _ = writeln!(
+            out,
+            "bench yardstick=hand-pmb particles={n} force_pass_ms_generic={:.3} force_pass_ms_hand={:.3} generic_overhead_percent={:+.1} identical_forces={} repeats={}",
+            1e3 * g,
+            1e3 * h,
+            100.0 * (g / h - 1.0),
+            same && same_broken,
+            opts.repeat.max(1)
+        );
+    }
+    Ok(out)
+}
+
+/// The PMB force pass written by hand for this one model: the yardstick of the generic path.
+/// Not used by the engine.
+#[allow(clippy::too_many_arguments)]
+pub fn hand_pmb_pass(
+    alter: &[Motion],
+    volume: &[f64],
+    offsets: &[u32],
+    partner: &[u32],
+    geom: &[crate::model::BondGeom],
+    broken: &mut [bool],
+    c: f64,
+    s0: f64,
+) -> Vec<[f64; 3]> {
+    let mut force = vec![[0.0f64; 3]; alter.len()];
+    for i in 0..offsets.len() - 1 {
+        let xi = alter[i].pos;
+        let vi = volume[i];
+        let mut fi = [0.0; 3];
+        for b in offsets[i] as usize..offsets[i + 1] as usize {
+            if broken[b] {
+                continue;
+            }
+            let j = partner[b] as usize;
+            let xj = alter[j].pos;
+            let y = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
+            let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+            let l = geom[b].length;
+            let e = r - l;
+            if e > s0 * l {
+                broken[b] = true;
+                continue;
+            }
+            let f = c * geom[b].beta * vi * volume[j] * e / (l * r);
+            let fv = [f * y[0], f * y[1], f * y[2]];
+            fi[0] += fv[0];
+            fi[1] += fv[1];
+            fi[2] += fv[2];
+            force[j][0] -= fv[0];
+            force[j][1] -= fv[1];
+            force[j][2] -= fv[2];
+        }
+        force[i][0] += fi[0];
+        force[i][1] += fi[1];
+        force[i][2] += fi[2];
+    }
+    force
+}
+
+/// LAMMPS `peri/pmb` on the same scene, if `lmp` is on the PATH.
+fn peer(opts: &BenchOptions) -> Result<String, String> {
+    let lmp = std::env::var("PDQ_LMP").unwrap_or_else(|_| "lmp".into());
+    let dir = std::env::temp_dir().join(format!("pdq-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
+    let input = dir.join("lammps_pmb.in");
+    std::fs::write(&input, LAMMPS_PMB).map_err(|e| e.to_string())?;
+    let output = Command::new(&lmp)
+        .current_dir(&dir)
+        .args(["-in", "lammps_pmb.in", "-var", "n"])
+        .arg(opts.n.to_string())
+        .args(["-var", "steps"])
+        .arg(opts.steps.to_string())
+        .args(["-log", "none"])
+        .output();
+    let _ = std::fs::remove_dir_all(&dir);
+    let output = match output {
+        Ok(o) => o,
+        Err(e) => {
+            return Ok(format!(
+                "bench peer=lammps-peri/pmb skipped: cannot run '{lmp}' ({e}); install it with apt-get install lammps\n"
+            ))
+        }
+    };
+    let text = String::from_utf8_lossy(&output.stdout);
+    // "Loop time of 61.4 on 1 procs for 200 steps with 68921 atoms"
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("Loop time of"))
+        .ok_or_else(|| format!("LAMMPS printed no 'Loop time' line:\n{text}"))?;
+    let w: Vec<&str> = line.split_whitespace().collect();
+    let secs: f64 = w
+        .get(3)
+        .and_then(|s| s.parse().ok())
+        .ok_or("bad Loop time line")?;
+    let atoms: f64 = w
+        .get(11)
+        .and_then(|s| s.parse().ok())
+        .ok_or("bad Loop time line")?;
+    let steps: f64 = w
+        .get(8)
+        .and_then(|s| s.parse().ok())
+        .ok_or("bad Loop time line")?;
+    Ok(format!(
+        "bench peer=lammps-peri/pmb particles={atoms} steps={steps} threads=1 ranks=1 us_per_particle_step={:.4}\n",
+        1e6 * secs / (atoms * steps)
+    ))
+}

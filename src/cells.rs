@@ -1,0 +1,151 @@
+//! Uniform cells no smaller than the horizon, and the 13-cell half shell (thesis 3.4–3.5).
+//!
+//! Every pair of particles closer than the horizon lies in the same cell or in adjacent cells.
+//! Pairing each cell with itself and with the 13 neighbours of [`HALF_SHELL`] visits every
+//! adjacent pair of cells exactly once, so every pair of particles is found exactly once.
+
+/// Forward neighbours: (dx, dy, dz) with dz > 0, or dz = 0 and dy > 0, or dz = dy = 0 and dx > 0.
+/// Their negatives are the other 13 of the 26 neighbours.
+pub const HALF_SHELL: [[i32; 3]; 13] = [
+    [1, 0, 0],
+    [-1, 1, 0],
+    [0, 1, 0],
+    [1, 1, 0],
+    [-1, -1, 1],
+    [0, -1, 1],
+    [1, -1, 1],
+    [-1, 0, 1],
+    [0, 0, 1],
+    [1, 0, 1],
+    [-1, 1, 1],
+    [0, 1, 1],
+    [1, 1, 1],
+];
+
+/// A box of cells over a set of points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CellGrid {
+    pub origin: [f64; 3],
+    pub size: [f64; 3],
+    pub dims: [usize; 3],
+}
+
+impl CellGrid {
+    /// Cells of side ≥ `min_size` covering every point.
+    pub fn covering(points: &[[f64; 3]], min_size: f64) -> CellGrid {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in points {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        if points.is_empty() {
+            lo = [0.0; 3];
+            hi = [0.0; 3];
+        }
+        let mut dims = [1usize; 3];
+        let mut size = [min_size; 3];
+        for k in 0..3 {
+            let extent = hi[k] - lo[k];
+            let n = (extent / min_size).floor().max(1.0) as usize;
+            dims[k] = n;
+            // Stretch the cells so that n of them span the extent exactly; never below min_size.
+            size[k] = (extent / n as f64).max(min_size);
+        }
+        CellGrid {
+            origin: lo,
+            size,
+            dims,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.dims[0] * self.dims[1] * self.dims[2]
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Integer cell coordinates of a point (clamped into the grid).
+    #[inline]
+    pub fn coords(&self, p: &[f64; 3]) -> [usize; 3] {
+        let mut c = [0usize; 3];
+        for k in 0..3 {
+            let f = ((p[k] - self.origin[k]) / self.size[k]).floor();
+            c[k] = (f.max(0.0) as usize).min(self.dims[k] - 1);
+        }
+        c
+    }
+
+    #[inline]
+    pub fn index(&self, c: [usize; 3]) -> usize {
+        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+    }
+
+    /// The neighbour of cell `c` at `offset`, if inside the grid.
+    #[inline]
+    pub fn neighbour(&self, c: [usize; 3], offset: [i32; 3]) -> Option<usize> {
+        let mut n = [0usize; 3];
+        for k in 0..3 {
+            let v = c[k] as i64 + offset[k] as i64;
+            if v < 0 || v >= self.dims[k] as i64 {
+                return None;
+            }
+            n[k] = v as usize;
+        }
+        Some(self.index(n))
+    }
+
+    /// Cell of each point and the points grouped by cell: `(cell_of, start, order)` where the
+    /// points of cell c are `order[start[c]..start[c + 1]]`, in increasing point index.
+    pub fn bin(&self, points: &[[f64; 3]]) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+        let cell_of: Vec<u32> = points
+            .iter()
+            .map(|p| self.index(self.coords(p)) as u32)
+            .collect();
+        let mut start = vec![0u32; self.len() + 1];
+        for &c in &cell_of {
+            start[c as usize + 1] += 1;
+        }
+        for c in 0..self.len() {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut order = vec![0u32; points.len()];
+        for (i, &c) in cell_of.iter().enumerate() {
+            order[fill[c as usize] as usize] = i as u32;
+            fill[c as usize] += 1;
+        }
+        (cell_of, start, order)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_shell_is_half_of_the_neighbourhood() {
+        let mut all = Vec::new();
+        for o in HALF_SHELL {
+            all.push(o);
+            all.push([-o[0], -o[1], -o[2]]);
+        }
+        all.sort();
+        all.dedup();
+        assert_eq!(all.len(), 26);
+        assert!(!all.contains(&[0, 0, 0]));
+    }
+
+    #[test]
+    fn cells_are_never_smaller_than_requested() {
+        let pts = [[0.0, 0.0, 0.0], [10.0, 2.5, 0.0]];
+        let g = CellGrid::covering(&pts, 3.0);
+        assert_eq!(g.dims, [3, 1, 1]);
+        assert!(g.size.iter().all(|&s| s >= 3.0));
+        assert_eq!(g.coords(&pts[1]), [2, 0, 0]);
+    }
+}

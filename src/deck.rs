@@ -1,0 +1,1097 @@
+//! The input deck: TOML in, engine types out.
+//!
+//! This is the only module that knows TOML. Unknown keys are errors with their line (serde's
+//! `deny_unknown_fields`, located by the toml crate); every quantity may carry units, which are
+//! checked against the dimension the key expects and converted once into the deck's unit system
+//! (see [`crate::units`]); anything semantically wrong is reported with the entry's line.
+
+use crate::boundary::{History, Motion};
+use crate::geometry::{Bar, Lattice, Op, Shape};
+use crate::model::{Material, MaterialKind};
+use crate::simulation::Integrator;
+use crate::units::{
+    AccelerationVector, Area, Density, EnergyPerArea, ForceDensity, ForceVector, Length,
+    Micromodulus, Position, Stress, Time, UnitSystem, Vector, VelocityVector,
+};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// A deck problem, with the file and line it comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeckError {
+    pub file: String,
+    pub line: Option<usize>,
+    pub message: String,
+}
+
+impl fmt::Display for DeckError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{}:{}: {}", self.file, l, self.message),
+            None => write!(f, "{}: {}", self.file, self.message),
+        }
+    }
+}
+
+impl std::error::Error for DeckError {}
+
+// ---------------------------------------------------------------------------------------------
+// The TOML layout.
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DeckFile {
+    title: Option<String>,
+    units: Spanned<String>,
+    model: Spanned<ModelSection>,
+    lattice: Spanned<LatticeSection>,
+    materials: Spanned<BTreeMap<String, Spanned<MaterialSection>>>,
+    #[serde(default)]
+    geometry: Vec<Spanned<ShapeSpec>>,
+    #[serde(default)]
+    bar: Vec<Spanned<BarSection>>,
+    time: Spanned<TimeSection>,
+    #[serde(default)]
+    boundary: Vec<Spanned<BoundarySection>>,
+    #[serde(default)]
+    load: Vec<Spanned<LoadSection>>,
+    #[serde(default)]
+    initial: Vec<Spanned<InitialSection>>,
+    #[serde(default)]
+    output: Option<Spanned<OutputSection>>,
+    #[serde(default)]
+    probe: Vec<Spanned<ProbeSection>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModelSection {
+    name: String,
+    horizon: Option<Length>,
+    /// Horizon as a multiple of the lattice spacing.
+    m: Option<f64>,
+    partial_volume: Option<bool>,
+    #[serde(default)]
+    options: BTreeMap<String, f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LatticeSection {
+    spacing: Length,
+    origin: Option<Position>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialSection {
+    kind: Option<String>,
+    density: Density,
+    #[serde(alias = "E")]
+    youngs_modulus: Option<Stress>,
+    #[serde(alias = "nu")]
+    poisson_ratio: Option<f64>,
+    #[serde(alias = "K")]
+    bulk_modulus: Option<Stress>,
+    micromodulus: Option<Micromodulus>,
+    critical_stretch: Option<f64>,
+    #[serde(alias = "G0")]
+    fracture_energy: Option<EnergyPerArea>,
+    tensile_stretch: Option<f64>,
+    compressive_stretch: Option<f64>,
+    yield_stretch: Option<f64>,
+    failure_stretch: Option<f64>,
+    #[serde(alias = "fc")]
+    compressive_strength: Option<Stress>,
+}
+
+/// A shape for geometry entries and regions; which keys apply depends on `shape`.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct ShapeSpec {
+    shape: Option<String>,
+    /// Geometry only: "add" (default) or "subtract".
+    op: Option<String>,
+    /// Geometry only: material filled in by "add".
+    material: Option<String>,
+    /// Regions only: explicit global particle ids.
+    ids: Option<Vec<u32>>,
+    min: Option<Position>,
+    max: Option<Position>,
+    base: Option<Position>,
+    center: Option<Position>,
+    axis: Option<AxisSpec>,
+    length: Option<Length>,
+    radius: Option<Length>,
+    polygon: Option<Vec<[Length; 2]>>,
+    from: Option<Length>,
+    to: Option<Length>,
+}
+
+#[derive(Deserialize, Clone)]
+#[serde(untagged)]
+enum AxisSpec {
+    Name(String),
+    Direction([f64; 3]),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BarSection {
+    material: String,
+    area: Area,
+    from: Position,
+    to: Option<Position>,
+    direction: Option<[f64; 3]>,
+    azimuth: Option<f64>,
+    elevation: Option<f64>,
+    length: Option<Length>,
+    spacing: Option<Length>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TimeSection {
+    steps: Option<u64>,
+    duration: Option<Time>,
+    dt: Option<Time>,
+    safety_factor: Option<f64>,
+    force_dt: Option<bool>,
+    integrator: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HistorySpec {
+    ramp: Option<Time>,
+    table: Option<Vec<(Time, f64)>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BoundarySection {
+    name: String,
+    region: ShapeSpec,
+    fixed: Option<Vec<String>>,
+    velocity: Option<VelocityVector>,
+    displacement: Option<Position>,
+    components: Option<Vec<String>>,
+    history: Option<HistorySpec>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LoadSection {
+    name: String,
+    region: Option<ShapeSpec>,
+    force_per_particle: Option<ForceVector>,
+    total_force: Option<ForceVector>,
+    body_force: Option<Vector<1, -2, -2>>,
+    gravity: Option<AccelerationVector>,
+    history: Option<HistorySpec>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct InitialSection {
+    region: Option<ShapeSpec>,
+    velocity: VelocityVector,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct OutputSection {
+    directory: Option<String>,
+    history_every: Option<u64>,
+    frames_every: Option<u64>,
+    progress: Option<bool>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProbeSection {
+    name: String,
+    at: Position,
+}
+
+// ---------------------------------------------------------------------------------------------
+// What the engine gets.
+
+/// A set of particles, selected in the reference configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Region {
+    All,
+    Shape(Shape),
+    Ids(Vec<u32>),
+}
+
+/// How long to run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RunLength {
+    Steps(u64),
+    Duration(f64),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeSpec {
+    pub length: RunLength,
+    pub dt: Option<f64>,
+    pub safety_factor: f64,
+    pub force_dt: bool,
+    pub integrator: Integrator,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoundarySpec {
+    pub name: String,
+    pub line: usize,
+    pub region: Region,
+    pub dofs: Vec<usize>,
+    pub motion: Motion,
+    pub history: History,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LoadKind {
+    /// The vector on every particle of the region.
+    PerParticle([f64; 3]),
+    /// The vector shared among the region's particles in proportion to their volumes.
+    Total([f64; 3]),
+    /// Force per unit volume.
+    BodyForce([f64; 3]),
+    /// Acceleration, applied as mass × g.
+    Gravity([f64; 3]),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadSpec {
+    pub name: String,
+    pub line: usize,
+    pub region: Region,
+    pub kind: LoadKind,
+    pub history: History,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct InitialSpec {
+    pub line: usize,
+    pub region: Region,
+    pub velocity: [f64; 3],
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputSpec {
+    pub directory: PathBuf,
+    pub history_every: u64,
+    pub frames_every: u64,
+    pub progress: bool,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProbeSpec {
+    pub name: String,
+    pub line: usize,
+    pub at: [f64; 3],
+}
+
+/// A deck after checking and unit conversion: everything in the deck's unit system.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub file: String,
+    pub title: String,
+    pub units: UnitSystem,
+    pub model: String,
+    pub model_line: usize,
+    pub model_options: Vec<(String, f64)>,
+    pub horizon: f64,
+    pub spacing: f64,
+    pub partial_volume: bool,
+    pub materials: Vec<Material>,
+    pub lattice: Lattice,
+    pub ops: Vec<Op>,
+    /// Deck line of each geometry entry, for messages.
+    pub op_lines: Vec<usize>,
+    pub bars: Vec<Bar>,
+    pub bar_lines: Vec<usize>,
+    pub time: TimeSpec,
+    pub boundaries: Vec<BoundarySpec>,
+    pub loads: Vec<LoadSpec>,
+    pub initial: Vec<InitialSpec>,
+    pub output: OutputSpec,
+    pub probes: Vec<ProbeSpec>,
+}
+
+impl Scene {
+    /// An error located at `line` of this deck.
+    pub fn error(&self, line: Option<usize>, message: impl Into<String>) -> DeckError {
+        DeckError {
+            file: self.file.clone(),
+            line,
+            message: message.into(),
+        }
+    }
+}
+
+/// Reads and checks a deck file.
+pub fn load(path: &Path) -> Result<Scene, DeckError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| DeckError {
+        file: file.clone(),
+        line: None,
+        message: format!("cannot read the deck: {e}"),
+    })?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "run".into());
+    parse(&text, &file, &stem)
+}
+
+/// Checks a deck given as text; `file` names it in messages, `stem` names the default output.
+pub fn parse(text: &str, file: &str, stem: &str) -> Result<Scene, DeckError> {
+    let lines = LineIndex::new(text);
+    let deck: DeckFile = toml::from_str(text).map_err(|e| {
+        let line = e.span().map(|s| lines.line(s.start));
+        DeckError {
+            file: file.to_string(),
+            line,
+            message: e.message().trim().to_string(),
+        }
+    })?;
+    Converter {
+        file: file.to_string(),
+        lines,
+        sys: UnitSystem::Si,
+    }
+    .scene(deck, stem)
+}
+
+/// Byte offset → 1-based line number.
+struct LineIndex {
+    starts: Vec<usize>,
+}
+
+impl LineIndex {
+    fn new(text: &str) -> Self {
+        let mut starts = vec![0];
+        starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
+        LineIndex { starts }
+    }
+
+    fn line(&self, offset: usize) -> usize {
+        self.starts.partition_point(|&s| s <= offset)
+    }
+}
+
+struct Converter {
+    file: String,
+    lines: LineIndex,
+    sys: UnitSystem,
+}
+
+type R<T> = Result<T, DeckError>;
+
+impl Converter {
+    fn err<T>(&self, line: usize, message: impl Into<String>) -> R<T> {
+        Err(DeckError {
+            file: self.file.clone(),
+            line: Some(line),
+            message: message.into(),
+        })
+    }
+
+    fn line_of<T>(&self, s: &Spanned<T>) -> usize {
+        self.lines.line(s.span().start)
+    }
+
+    fn scene(mut self, deck: DeckFile, stem: &str) -> R<Scene> {
+        let units_line = self.line_of(&deck.units);
+        self.sys = UnitSystem::from_name(deck.units.get_ref())
+            .or_else(|e| self.err(units_line, format!("units: {e}")))?;
+        let sys = self.sys;
+
+        // Materials, in name order; their index is the material id.
+        let mat_names: Vec<String> = deck.materials.get_ref().keys().cloned().collect();
+        if mat_names.is_empty() {
+            return self.err(
+                self.line_of(&deck.materials),
+                "[materials] defines no material",
+            );
+        }
+        if mat_names.len() > u16::MAX as usize {
+            return self.err(self.line_of(&deck.materials), "too many materials");
+        }
+        let mut materials = Vec::new();
+        for (name, m) in deck.materials.get_ref() {
+            materials.push(self.material(name, m)?);
+        }
+        let material_id = |name: &str, line: usize| -> R<u16> {
+            match mat_names.iter().position(|n| n == name) {
+                Some(i) => Ok(i as u16),
+                None => self.err(
+                    line,
+                    format!(
+                        "unknown material '{name}' (materials: {})",
+                        mat_names.join(", ")
+                    ),
+                ),
+            }
+        };
+
+        // Lattice and horizon.
+        let lat_line = self.line_of(&deck.lattice);
+        let spacing = deck.lattice.get_ref().spacing.value(sys);
+        if !(spacing.is_finite() && spacing > 0.0) {
+            return self.err(
+                lat_line,
+                format!("lattice spacing must be > 0 (got {spacing})"),
+            );
+        }
+        let origin = deck
+            .lattice
+            .get_ref()
+            .origin
+            .map(|o| o.value(sys))
+            .unwrap_or([0.0; 3]);
+        let model_line = self.line_of(&deck.model);
+        let ms = deck.model.into_inner();
+        let horizon = match (ms.horizon, ms.m) {
+            (Some(h), None) => h.value(sys),
+            (None, Some(m)) => m * spacing,
+            (None, None) => {
+                return self.err(
+                    model_line,
+                    "[model] needs 'horizon' or 'm' (horizon / spacing)",
+                )
+            }
+            (Some(_), Some(_)) => {
+                return self.err(model_line, "[model] give 'horizon' or 'm', not both")
+            }
+        };
+        if !(horizon.is_finite() && horizon > 0.0) {
+            return self.err(
+                model_line,
+                format!("[model] horizon must be > 0 (got {horizon})"),
+            );
+        }
+        if horizon < spacing {
+            return self.err(
+                model_line,
+                format!("[model] horizon {horizon} is smaller than the lattice spacing {spacing}: particles would have no bonds"),
+            );
+        }
+
+        // Geometry.
+        let mut ops = Vec::new();
+        let mut op_lines = Vec::new();
+        for (k, g) in deck.geometry.iter().enumerate() {
+            let line = self.line_of(g);
+            let g = g.get_ref();
+            let ctx = format!("geometry entry {k}");
+            if g.ids.is_some() {
+                return self.err(
+                    line,
+                    format!("{ctx}: 'ids' selects particles in regions, not in geometry"),
+                );
+            }
+            let shape = self.shape(g, line, &ctx)?;
+            match g.op.as_deref().unwrap_or("add") {
+                "add" => {
+                    let Some(mat) = &g.material else {
+                        return self.err(line, format!("{ctx}: an 'add' entry needs 'material'"));
+                    };
+                    ops.push(Op::Add {
+                        shape,
+                        material: material_id(mat, line)?,
+                    });
+                }
+                "subtract" => {
+                    if g.material.is_some() {
+                        return self
+                            .err(line, format!("{ctx}: a 'subtract' entry takes no material"));
+                    }
+                    ops.push(Op::Subtract { shape });
+                }
+                other => {
+                    return self.err(
+                        line,
+                        format!("{ctx}: op must be \"add\" or \"subtract\", not \"{other}\""),
+                    )
+                }
+            }
+            op_lines.push(line);
+        }
+        let mut bars = Vec::new();
+        let mut bar_lines = Vec::new();
+        for (k, b) in deck.bar.iter().enumerate() {
+            let line = self.line_of(b);
+            bars.push(self.bar(b.get_ref(), k, line, spacing, &material_id)?);
+            bar_lines.push(line);
+        }
+        if ops.is_empty() && bars.is_empty() {
+            return self.err(
+                1,
+                "the deck has no [[geometry]] or [[bar]] entry: there are no particles",
+            );
+        }
+
+        // Time.
+        let time_line = self.line_of(&deck.time);
+        let t = deck.time.into_inner();
+        let length = match (t.steps, t.duration) {
+            (Some(n), None) => RunLength::Steps(n),
+            (None, Some(d)) => {
+                let d = d.value(sys);
+                if !(d.is_finite() && d > 0.0) {
+                    return self.err(time_line, format!("[time] duration must be > 0 (got {d})"));
+                }
+                RunLength::Duration(d)
+            }
+            (None, None) => return self.err(time_line, "[time] needs 'steps' or 'duration'"),
+            (Some(_), Some(_)) => {
+                return self.err(time_line, "[time] give 'steps' or 'duration', not both")
+            }
+        };
+        let dt = t.dt.map(|d| d.value(sys));
+        if let Some(d) = dt {
+            if !(d.is_finite() && d > 0.0) {
+                return self.err(time_line, format!("[time] dt must be > 0 (got {d})"));
+            }
+        }
+        let safety_factor = t.safety_factor.unwrap_or(0.8);
+        if !(safety_factor > 0.0 && safety_factor <= 1.0) {
+            return self.err(
+                time_line,
+                format!("[time] safety_factor must lie in (0, 1] (got {safety_factor})"),
+            );
+        }
+        if dt.is_some() && t.safety_factor.is_some() {
+            return self.err(time_line, "[time] give 'dt' or 'safety_factor', not both");
+        }
+        let integrator = match t.integrator.as_deref().unwrap_or("verlet") {
+            "verlet" | "velocity-verlet" => Integrator::VelocityVerlet,
+            "euler" | "semi-implicit-euler" => Integrator::SemiImplicitEuler,
+            other => {
+                return self.err(
+                    time_line,
+                    format!("[time] unknown integrator '{other}' (use \"verlet\" or \"euler\")"),
+                )
+            }
+        };
+
+        // Boundary conditions, loads, initial velocities.
+        let mut boundaries = Vec::new();
+        let mut names = Vec::new();
+        for b in &deck.boundary {
+            let line = self.line_of(b);
+            let spec = self.boundary(b.get_ref(), line)?;
+            if names.contains(&spec.name) {
+                return self.err(line, format!("boundary name '{}' is used twice", spec.name));
+            }
+            names.push(spec.name.clone());
+            boundaries.push(spec);
+        }
+        let mut loads = Vec::new();
+        for l in &deck.load {
+            let line = self.line_of(l);
+            let spec = self.load(l.get_ref(), line)?;
+            if names.contains(&spec.name) {
+                return self.err(line, format!("load name '{}' is used twice", spec.name));
+            }
+            names.push(spec.name.clone());
+            loads.push(spec);
+        }
+        let mut initial = Vec::new();
+        for i in &deck.initial {
+            let line = self.line_of(i);
+            let s = i.get_ref();
+            let region = match &s.region {
+                Some(r) => self.region(r, line, "initial")?,
+                None => Region::All,
+            };
+            initial.push(InitialSpec {
+                line,
+                region,
+                velocity: s.velocity.value(sys),
+            });
+        }
+
+        // Output and probes.
+        let (out, out_line) = match &deck.output {
+            Some(o) => (o.get_ref(), self.line_of(o)),
+            None => (&OutputSection::default(), 1),
+        };
+        let history_every = out.history_every.unwrap_or(10);
+        if history_every == 0 {
+            return self.err(out_line, "[output] history_every must be ≥ 1");
+        }
+        let output = OutputSpec {
+            directory: PathBuf::from(
+                out.directory
+                    .clone()
+                    .unwrap_or_else(|| format!("out/{stem}")),
+            ),
+            history_every,
+            frames_every: out.frames_every.unwrap_or(0),
+            progress: out.progress.unwrap_or(true),
+        };
+        let mut probes = Vec::new();
+        for p in &deck.probe {
+            let line = self.line_of(p);
+            let name = p.get_ref().name.clone();
+            if !valid_name(&name) {
+                return self.err(
+                    line,
+                    format!("probe name '{name}' must be letters, digits, '_' or '-'"),
+                );
+            }
+            probes.push(ProbeSpec {
+                name,
+                line,
+                at: p.get_ref().at.value(sys),
+            });
+        }
+
+        Ok(Scene {
+            file: self.file.clone(),
+            title: deck.title.unwrap_or_else(|| stem.to_string()),
+            units: sys,
+            model: ms.name,
+            model_line,
+            model_options: ms.options.into_iter().collect(),
+            horizon,
+            spacing,
+            partial_volume: ms.partial_volume.unwrap_or(true),
+            materials,
+            lattice: Lattice { spacing, origin },
+            ops,
+            op_lines,
+            bars,
+            bar_lines,
+            time: TimeSpec {
+                length,
+                dt,
+                safety_factor,
+                force_dt: t.force_dt.unwrap_or(false),
+                integrator,
+            },
+            boundaries,
+            loads,
+            initial,
+            output,
+            probes,
+        })
+    }
+
+    fn material(&self, name: &str, m: &Spanned<MaterialSection>) -> R<Material> {
+        let line = self.line_of(m);
+        let s = m.get_ref();
+        let sys = self.sys;
+        let ctx = format!("material '{name}'");
+        let kind =
+            match s.kind.as_deref().unwrap_or("solid") {
+                "solid" => MaterialKind::Solid,
+                "concrete" => MaterialKind::Concrete,
+                "steel" => MaterialKind::Steel,
+                other => return self.err(
+                    line,
+                    format!(
+                        "{ctx}: unknown kind '{other}' (use \"solid\", \"concrete\" or \"steel\")"
+                    ),
+                ),
+            };
+        let density = s.density.value(sys);
+        if !(density.is_finite() && density > 0.0) {
+            return self.err(line, format!("{ctx}: density must be > 0 (got {density})"));
+        }
+        let positive = |v: Option<f64>, key: &str| -> R<Option<f64>> {
+            match v {
+                Some(x) if !(x.is_finite() && x > 0.0) => {
+                    self.err(line, format!("{ctx}: {key} must be > 0 (got {x})"))
+                }
+                _ => Ok(v),
+            }
+        };
+        let mut mat = Material::new(name, kind, density);
+        mat.youngs_modulus = positive(s.youngs_modulus.map(|q| q.value(sys)), "youngs_modulus")?;
+        mat.bulk_modulus = positive(s.bulk_modulus.map(|q| q.value(sys)), "bulk_modulus")?;
+        mat.micromodulus = positive(s.micromodulus.map(|q| q.value(sys)), "micromodulus")?;
+        mat.fracture_energy = positive(s.fracture_energy.map(|q| q.value(sys)), "fracture_energy")?;
+        mat.critical_stretch = positive(s.critical_stretch, "critical_stretch")?;
+        mat.tensile_stretch = positive(s.tensile_stretch, "tensile_stretch")?;
+        mat.yield_stretch = positive(s.yield_stretch, "yield_stretch")?;
+        mat.failure_stretch = positive(s.failure_stretch, "failure_stretch")?;
+        mat.compressive_strength = positive(
+            s.compressive_strength.map(|q| q.value(sys)),
+            "compressive_strength",
+        )?;
+        if let Some(c) = s.compressive_stretch {
+            if !(c.is_finite() && c < 0.0) {
+                return self.err(
+                    line,
+                    format!("{ctx}: compressive_stretch must be < 0 (got {c})"),
+                );
+            }
+        }
+        mat.compressive_stretch = s.compressive_stretch;
+        if let Some(nu) = s.poisson_ratio {
+            if !(nu > -1.0 && nu < 0.5) {
+                return self.err(
+                    line,
+                    format!("{ctx}: poisson_ratio must lie in (-1, 0.5) (got {nu})"),
+                );
+            }
+        }
+        mat.poisson_ratio = s.poisson_ratio;
+        Ok(mat)
+    }
+
+    fn axis_index(&self, a: &Option<AxisSpec>, line: usize, ctx: &str) -> R<usize> {
+        match a {
+            Some(AxisSpec::Name(n)) => match n.as_str() {
+                "x" => Ok(0),
+                "y" => Ok(1),
+                "z" => Ok(2),
+                _ => self.err(line, format!("{ctx}: axis must be \"x\", \"y\" or \"z\" (got \"{n}\")")),
+            },
+            Some(AxisSpec::Direction(_)) => self.err(
+                line,
+                format!("{ctx}: this shape needs a coordinate axis \"x\", \"y\" or \"z\", not a direction"),
+            ),
+            None => self.err(line, format!("{ctx}: needs 'axis'")),
+        }
+    }
+
+    fn shape(&self, g: &ShapeSpec, line: usize, ctx: &str) -> R<Shape> {
+        let sys = self.sys;
+        let Some(kind) = g.shape.as_deref() else {
+            return self.err(
+                line,
+                format!("{ctx}: needs 'shape' (box, cylinder, sphere, prism or slab)"),
+            );
+        };
+        let allowed: &[&str] = match kind {
+            "box" => &["min", "max"],
+            "cylinder" => &["base", "axis", "length", "radius"],
+            "sphere" => &["center", "radius"],
+            "prism" => &["axis", "polygon", "from", "to"],
+            "slab" => &["axis", "from", "to"],
+            other => {
+                return self.err(
+                    line,
+                    format!(
+                        "{ctx}: unknown shape '{other}' (box, cylinder, sphere, prism or slab)"
+                    ),
+                )
+            }
+        };
+        let present = [
+            ("min", g.min.is_some()),
+            ("max", g.max.is_some()),
+            ("base", g.base.is_some()),
+            ("center", g.center.is_some()),
+            ("axis", g.axis.is_some()),
+            ("length", g.length.is_some()),
+            ("radius", g.radius.is_some()),
+            ("polygon", g.polygon.is_some()),
+            ("from", g.from.is_some()),
+            ("to", g.to.is_some()),
+        ];
+        for (key, is) in present {
+            if is && !allowed.contains(&key) {
+                return self.err(
+                    line,
+                    format!(
+                        "{ctx}: a {kind} does not take '{key}' (it takes {})",
+                        allowed.join(", ")
+                    ),
+                );
+            }
+            if !is && allowed.contains(&key) {
+                return self.err(line, format!("{ctx}: a {kind} needs '{key}'"));
+            }
+        }
+        let shape = match kind {
+            "box" => Shape::Box {
+                min: g.min.unwrap().value(sys),
+                max: g.max.unwrap().value(sys),
+            },
+            "cylinder" => Shape::Cylinder {
+                base: g.base.unwrap().value(sys),
+                axis: match g.axis.clone().unwrap() {
+                    AxisSpec::Direction(d) => d,
+                    AxisSpec::Name(_) => {
+                        let mut d = [0.0; 3];
+                        d[self.axis_index(&g.axis, line, ctx)?] = 1.0;
+                        d
+                    }
+                },
+                length: g.length.unwrap().value(sys),
+                radius: g.radius.unwrap().value(sys),
+            },
+            "sphere" => Shape::Sphere {
+                center: g.center.unwrap().value(sys),
+                radius: g.radius.unwrap().value(sys),
+            },
+            "prism" => Shape::Prism {
+                axis: self.axis_index(&g.axis, line, ctx)?,
+                polygon: g
+                    .polygon
+                    .as_ref()
+                    .unwrap()
+                    .iter()
+                    .map(|[a, b]| [a.value(sys), b.value(sys)])
+                    .collect(),
+                from: g.from.unwrap().value(sys),
+                to: g.to.unwrap().value(sys),
+            },
+            _ => Shape::Slab {
+                axis: self.axis_index(&g.axis, line, ctx)?,
+                from: g.from.unwrap().value(sys),
+                to: g.to.unwrap().value(sys),
+            },
+        };
+        shape
+            .validate()
+            .or_else(|e| self.err(line, format!("{ctx} ({kind}): {e}")))?;
+        Ok(shape)
+    }
+
+    fn region(&self, r: &ShapeSpec, line: usize, ctx: &str) -> R<Region> {
+        let ctx = format!("{ctx}: region");
+        if r.op.is_some() || r.material.is_some() {
+            return self.err(
+                line,
+                format!("{ctx}: 'op' and 'material' belong to geometry entries"),
+            );
+        }
+        if let Some(ids) = &r.ids {
+            if r.shape.is_some() {
+                return self.err(line, format!("{ctx}: give 'ids' or 'shape', not both"));
+            }
+            if ids.is_empty() {
+                return self.err(line, format!("{ctx}: 'ids' is empty"));
+            }
+            return Ok(Region::Ids(ids.clone()));
+        }
+        if r.shape.as_deref() == Some("all") {
+            return Ok(Region::All);
+        }
+        Ok(Region::Shape(self.shape(r, line, &ctx)?))
+    }
+
+    fn bar(
+        &self,
+        b: &BarSection,
+        k: usize,
+        line: usize,
+        lattice_spacing: f64,
+        material_id: &dyn Fn(&str, usize) -> R<u16>,
+    ) -> R<Bar> {
+        let sys = self.sys;
+        let ctx = format!("bar {k}");
+        let material = material_id(&b.material, line)?;
+        let area = b.area.value(sys);
+        if !(area.is_finite() && area > 0.0) {
+            return self.err(line, format!("{ctx}: area must be > 0 (got {area})"));
+        }
+        let spacing = b.spacing.map(|s| s.value(sys)).unwrap_or(lattice_spacing);
+        if !(spacing.is_finite() && spacing > 0.0) {
+            return self.err(line, format!("{ctx}: spacing must be > 0 (got {spacing})"));
+        }
+        let from = b.from.value(sys);
+        let length = b.length.map(|l| l.value(sys));
+        let bar = match (b.to, b.direction, b.azimuth.is_some() || b.elevation.is_some(), length) {
+            (Some(to), None, false, None) => Bar {
+                from,
+                to: to.value(sys),
+                area,
+                spacing,
+                material,
+            },
+            (None, Some(dir), false, Some(len)) => Bar::along(from, dir, len, area, spacing, material),
+            (None, None, true, Some(len)) => Bar::at_angle(
+                from,
+                b.azimuth.unwrap_or(0.0),
+                b.elevation.unwrap_or(0.0),
+                len,
+                area,
+                spacing,
+                material,
+            ),
+            _ => {
+                return self.err(
+                    line,
+                    format!("{ctx}: give 'to', or 'direction' and 'length', or 'azimuth'/'elevation' (degrees) and 'length'"),
+                )
+            }
+        };
+        if let Some(len) = length {
+            if !(len.is_finite() && len > 0.0) {
+                return self.err(line, format!("{ctx}: length must be > 0 (got {len})"));
+            }
+        }
+        Ok(bar)
+    }
+
+    fn history(&self, h: &Option<HistorySpec>, line: usize, ctx: &str) -> R<History> {
+        let hist = match h {
+            None => History::Constant,
+            Some(HistorySpec {
+                ramp: Some(r),
+                table: None,
+            }) => History::Ramp {
+                duration: r.value(self.sys),
+            },
+            Some(HistorySpec {
+                ramp: None,
+                table: Some(t),
+            }) => History::Table(t.iter().map(|(t, f)| (t.value(self.sys), *f)).collect()),
+            Some(_) => {
+                return self.err(
+                    line,
+                    format!("{ctx}: history takes one of 'ramp' or 'table'"),
+                )
+            }
+        };
+        hist.validate()
+            .or_else(|e| self.err(line, format!("{ctx}: {e}")))?;
+        Ok(hist)
+    }
+
+    fn components(&self, names: &[String], line: usize, ctx: &str) -> R<Vec<usize>> {
+        let mut dofs = Vec::new();
+        for n in names {
+            let more: &[usize] = match n.as_str() {
+                "x" => &[0],
+                "y" => &[1],
+                "z" => &[2],
+                "all" => &[0, 1, 2],
+                other => return self.err(
+                    line,
+                    format!(
+                        "{ctx}: unknown component '{other}' (use \"x\", \"y\", \"z\" or \"all\")"
+                    ),
+                ),
+            };
+            for d in more {
+                if !dofs.contains(d) {
+                    dofs.push(*d);
+                }
+            }
+        }
+        if dofs.is_empty() {
+            return self.err(line, format!("{ctx}: no component selected"));
+        }
+        dofs.sort_unstable();
+        Ok(dofs)
+    }
+
+    fn boundary(&self, b: &BoundarySection, line: usize) -> R<BoundarySpec> {
+        let ctx = format!("boundary '{}'", b.name);
+        if !valid_name(&b.name) {
+            return self.err(
+                line,
+                format!("{ctx}: names are letters, digits, '_' or '-'"),
+            );
+        }
+        let region = self.region(&b.region, line, &ctx)?;
+        let history = self.history(&b.history, line, &ctx)?;
+        let comps = |c: &Option<Vec<String>>| -> R<Vec<usize>> {
+            match c {
+                Some(c) => self.components(c, line, &ctx),
+                None => Ok(vec![0, 1, 2]),
+            }
+        };
+        let (dofs, motion) = match (&b.fixed, b.velocity, b.displacement) {
+            (Some(f), None, None) => {
+                if b.components.is_some() {
+                    return self.err(line, format!("{ctx}: 'fixed' lists its own components"));
+                }
+                (self.components(f, line, &ctx)?, Motion::Fixed)
+            }
+            (None, Some(v), None) => {
+                let dofs = comps(&b.components)?;
+                let v = v.value(self.sys);
+                (
+                    dofs.clone(),
+                    Motion::Velocity(dofs.iter().map(|&d| v[d]).collect()),
+                )
+            }
+            (None, None, Some(u)) => {
+                let dofs = comps(&b.components)?;
+                let u = u.value(self.sys);
+                (
+                    dofs.clone(),
+                    Motion::Displacement(dofs.iter().map(|&d| u[d]).collect()),
+                )
+            }
+            _ => {
+                return self.err(
+                    line,
+                    format!("{ctx}: give exactly one of 'fixed', 'velocity' or 'displacement'"),
+                )
+            }
+        };
+        Ok(BoundarySpec {
+            name: b.name.clone(),
+            line,
+            region,
+            dofs,
+            motion,
+            history,
+        })
+    }
+
+    fn load(&self, l: &LoadSection, line: usize) -> R<LoadSpec> {
+        let ctx = format!("load '{}'", l.name);
+        if !valid_name(&l.name) {
+            return self.err(
+                line,
+                format!("{ctx}: names are letters, digits, '_' or '-'"),
+            );
+        }
+        let sys = self.sys;
+        let kinds: Vec<LoadKind> = [
+            l.force_per_particle
+                .map(|v| LoadKind::PerParticle(v.value(sys))),
+            l.total_force.map(|v| LoadKind::Total(v.value(sys))),
+            l.body_force.map(|v| LoadKind::BodyForce(v.value(sys))),
+            l.gravity.map(|v| LoadKind::Gravity(v.value(sys))),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        if kinds.len() != 1 {
+            return self.err(
+                line,
+                format!("{ctx}: give exactly one of 'force_per_particle', 'total_force', 'body_force' or 'gravity'"),
+            );
+        }
+        let region = match &l.region {
+            Some(r) => self.region(r, line, &ctx)?,
+            None => Region::All,
+        };
+        Ok(LoadSpec {
+            name: l.name.clone(),
+            line,
+            region,
+            kind: kinds[0],
+            history: self.history(&l.history, line, &ctx)?,
+        })
+    }
+}
+
+fn valid_name(n: &str) -> bool {
+    !n.is_empty()
+        && n.chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+/// Units are checked where the deck is read; these keep a type-level reminder of the dimension
+/// body forces carry (force per volume).
+#[allow(dead_code)]
+type BodyForce = ForceDensity;

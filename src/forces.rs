@@ -1,0 +1,147 @@
+//! The bond loops: the optional state pass and the pair pass, generic over the model.
+//!
+//! These are the only loops over bonds in a time step. Each bond is visited once from its
+//! owner; the model returns the generalized force on both ends and the loop adds them, so
+//! equal-and-opposite forces and unequal micropolar moments go through the same code.
+
+use crate::attributes::{add_assign, Attributes};
+use crate::bonds::BondList;
+use crate::model::{Model, Side};
+use crate::particles::Particles;
+
+/// Sums the model's per-particle state over intact bonds (owned and ghost ends). Does nothing,
+/// at compile time, for a model whose `State` is `()`.
+pub fn state_pass<M: Model>(model: &M, p: &mut Particles<M>, bonds: &BondList<M::Bond>) {
+    if <M::State as Attributes>::LEN == 0 {
+        return;
+    }
+    for s in p.state.iter_mut() {
+        *s = M::State::default();
+    }
+    let mut sum = vec![M::State::default(); p.len()];
+    for i in 0..p.n_owned {
+        for b in bonds.offsets[i] as usize..bonds.offsets[i + 1] as usize {
+            if bonds.broken[b] {
+                continue;
+            }
+            let j = bonds.partners()[b] as usize;
+            let (si, sj) = model.state(&p.side(i), &p.side(j), &bonds.geom[b], &bonds.history[b]);
+            add_assign(&mut sum[i], &si);
+            add_assign(&mut sum[j], &sj);
+        }
+    }
+    p.state = sum;
+}
+
+/// Turns summed states into final values (after the reverse sum brought ghosts' partials home).
+pub fn finish_state<M: Model>(model: &M, p: &mut Particles<M>) {
+    if <M::State as Attributes>::LEN == 0 {
+        return;
+    }
+    for i in 0..p.n_owned {
+        model.finish_state(&mut p.state[i], &p.fixed[i]);
+    }
+}
+
+/// Zeroes all forces, then adds every intact bond's forces to its two ends. Marks bonds the
+/// model breaks and returns how many broke.
+pub fn pair_pass<M: Model>(
+    model: &M,
+    p: &mut Particles<M>,
+    bonds: &mut BondList<M::Bond>,
+) -> usize {
+    let Particles {
+        n_owned,
+        x0,
+        volume,
+        material,
+        fixed,
+        alter,
+        state,
+        force,
+        ..
+    } = p;
+    for f in force.iter_mut() {
+        *f = M::Force::default();
+    }
+    let bonds_max_partner = bonds.max_partner();
+    let (offsets, partner, geom, broken, history) = bonds.parts_mut();
+    let n = x0.len();
+    assert!(
+        *n_owned <= n
+            && offsets.len() == *n_owned + 1
+            && [
+                volume.len(),
+                material.len(),
+                fixed.len(),
+                alter.len(),
+                state.len(),
+                force.len()
+            ]
+            .iter()
+            .all(|&l| l == n)
+            && bonds_max_partner < n,
+        "bond list does not match the particle store"
+    );
+    let mut newly_broken = 0;
+    for i in 0..*n_owned {
+        let side_i = Side::<M> {
+            x0: &x0[i],
+            volume: volume[i],
+            material: material[i],
+            alter: &alter[i],
+            fixed: &fixed[i],
+            state: &state[i],
+        };
+        let mut fi = M::Force::default();
+        let range = offsets[i] as usize..offsets[i + 1] as usize;
+        let (partner, geom) = (&partner[range.clone()], &geom[range.clone()]);
+        let (broken, history) = (&mut broken[range.clone()], &mut history[range]);
+        for k in 0..partner.len() {
+            if broken[k] {
+                continue;
+            }
+            let j = partner[k] as usize;
+            // SAFETY: every partner index is below the particle count (BondList keeps the partner
+            // list private and its maximum; checked above), and all
+            // per-particle arrays have that length. Unchecked access lets the compiler drop the
+            // loads of fields the model never reads, which bounds checks would keep alive.
+            let (side_j, fj) = unsafe {
+                (
+                    Side::<M> {
+                        x0: x0.get_unchecked(j),
+                        volume: *volume.get_unchecked(j),
+                        material: *material.get_unchecked(j),
+                        alter: alter.get_unchecked(j),
+                        fixed: fixed.get_unchecked(j),
+                        state: state.get_unchecked(j),
+                    },
+                    force.get_unchecked_mut(j),
+                )
+            };
+            match model.pair(&side_i, &side_j, &geom[k], &mut history[k]) {
+                Some((a, b)) => {
+                    add_assign(&mut fi, &a);
+                    add_assign(fj, &b);
+                }
+                None => {
+                    broken[k] = true;
+                    newly_broken += 1;
+                }
+            }
+        }
+        add_assign(&mut force[i], &fi);
+    }
+    newly_broken
+}
+
+/// Elastic energy stored in the intact bonds.
+pub fn strain_energy<M: Model>(model: &M, p: &Particles<M>, bonds: &BondList<M::Bond>) -> f64 {
+    let mut e = 0.0;
+    for (i, j, b) in bonds.iter() {
+        if !bonds.broken[b] {
+            e += model.energy(&p.side(i), &p.side(j), &bonds.geom[b], &bonds.history[b]);
+        }
+    }
+    e
+}

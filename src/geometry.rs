@@ -1,0 +1,788 @@
+//! Reference particle cloud of a scene: shapes filled on a simple-cubic lattice, plus bars.
+//!
+//! Overlap and boundary rules (user-visible, keep the docs in sync):
+//! - Sites sit at cell centres (`origin + spacing·(i + ½)`), so a face on a lattice plane never
+//!   touches a site and a box `[0, L]` holds exactly `L / spacing` sites per axis.
+//! - Box, Cylinder, Sphere and Prism are closed (a point on the surface is inside); Slab is
+//!   half-open `from <= p < to`. `build` widens every test by `1e-9·spacing` (Slab: shifts both
+//!   ends down by it) so a site lying on a face up to rounding gets the same answer however its
+//!   coordinate rounded.
+//! - Ops run in order on a map of filled sites: Add (re)fills with its material (later wins),
+//!   Subtract empties; a later Add refills subtracted sites.
+//! - Bars come last; a filled site closer than ¼ of the lattice spacing to a bar particle is
+//!   removed because it would coincide with that particle.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+pub type Vec3 = [f64; 3];
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+fn sub(a: Vec3, b: Vec3) -> Vec3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: Vec3, b: Vec3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn normalize(a: Vec3) -> Vec3 {
+    let n = dot(a, a).sqrt();
+    [a[0] / n, a[1] / n, a[2] / n]
+}
+fn all_finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    Box {
+        min: Vec3,
+        max: Vec3,
+    },
+    /// Axis from `base` along `axis` (any direction, normalized internally) for `length`.
+    Cylinder {
+        base: Vec3,
+        axis: Vec3,
+        length: f64,
+        radius: f64,
+    },
+    Sphere {
+        center: Vec3,
+        radius: f64,
+    },
+    /// Polygon in the plane normal to coordinate axis `axis` (0=x,1=y,2=z), extruded from `from` to `to` along it.
+    /// Vertices are (a, b) in the cyclic pair of the other axes: axis x -> (y, z), y -> (z, x), z -> (x, y). Either orientation; need not be convex (even-odd / crossing-number test).
+    Prism {
+        axis: usize,
+        polygon: Vec<[f64; 2]>,
+        from: f64,
+        to: f64,
+    },
+    /// Half-open slab a <= p[axis] < b — handy for regions.
+    Slab {
+        axis: usize,
+        from: f64,
+        to: f64,
+    },
+}
+
+/// Cyclic pair so that (u, v, axis) is right-handed and polygon orientation is stable per axis.
+fn plane_axes(axis: usize) -> (usize, usize) {
+    ((axis + 1) % 3, (axis + 2) % 3)
+}
+
+fn seg_dist2(q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 {
+        (((q[0] - a[0]) * dx + (q[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (ex, ey) = (q[0] - a[0] - t * dx, q[1] - a[1] - t * dy);
+    ex * ex + ey * ey
+}
+
+/// Even-odd rule, made closed by treating points within `tol` of an edge as inside.
+fn in_polygon(poly: &[[f64; 2]], q: [f64; 2], tol: f64) -> bool {
+    let mut inside = false;
+    for (n, &a) in poly.iter().enumerate() {
+        let b = poly[(n + 1) % poly.len()];
+        if seg_dist2(q, a, b) <= tol * tol {
+            return true;
+        }
+        if (a[1] > q[1]) != (b[1] > q[1]) {
+            let x = a[0] + (q[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
+            if q[0] < x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+fn polygon_area(poly: &[[f64; 2]]) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+impl Shape {
+    /// Exact test (no tolerance); see the module doc for which boundaries are inside.
+    pub fn contains(&self, p: Vec3) -> bool {
+        self.contains_tol(p, 0.0)
+    }
+
+    fn contains_tol(&self, p: Vec3, tol: f64) -> bool {
+        match self {
+            Shape::Box { min, max } => (0..3).all(|e| p[e] >= min[e] - tol && p[e] <= max[e] + tol),
+            Shape::Cylinder {
+                base,
+                axis,
+                length,
+                radius,
+            } => {
+                let d = sub(p, *base);
+                let t = dot(d, normalize(*axis));
+                let r = radius + tol;
+                t >= -tol && t <= length + tol && dot(d, d) - t * t <= r * r
+            }
+            Shape::Sphere { center, radius } => {
+                let d = sub(p, *center);
+                dot(d, d) <= (radius + tol) * (radius + tol)
+            }
+            Shape::Prism {
+                axis,
+                polygon,
+                from,
+                to,
+            } => {
+                let (u, v) = plane_axes(*axis);
+                *axis < 3
+                    && p[*axis] >= from - tol
+                    && p[*axis] <= to + tol
+                    && in_polygon(polygon, [p[u], p[v]], tol)
+            }
+            Shape::Slab { axis, from, to } => {
+                *axis < 3 && p[*axis] >= from - tol && p[*axis] < to - tol
+            }
+        }
+    }
+
+    /// Axis-aligned bounding box (may be infinite for Slab in the free axes).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let inf = f64::INFINITY;
+        match self {
+            Shape::Box { min, max } => (*min, *max),
+            Shape::Cylinder {
+                base,
+                axis,
+                length,
+                radius,
+            } => {
+                let a = normalize(*axis);
+                let (mut lo, mut hi) = ([0.0; 3], [0.0; 3]);
+                for e in 0..3 {
+                    let end = base[e] + length * a[e];
+                    let r = radius * (1.0 - a[e] * a[e]).max(0.0).sqrt();
+                    lo[e] = base[e].min(end) - r;
+                    hi[e] = base[e].max(end) + r;
+                }
+                (lo, hi)
+            }
+            Shape::Sphere { center, radius } => (
+                [center[0] - radius, center[1] - radius, center[2] - radius],
+                [center[0] + radius, center[1] + radius, center[2] + radius],
+            ),
+            Shape::Prism {
+                axis,
+                polygon,
+                from,
+                to,
+            } if *axis < 3 => {
+                let (u, v) = plane_axes(*axis);
+                let (mut lo, mut hi) = ([inf; 3], [-inf; 3]);
+                for q in polygon {
+                    lo[u] = lo[u].min(q[0]);
+                    hi[u] = hi[u].max(q[0]);
+                    lo[v] = lo[v].min(q[1]);
+                    hi[v] = hi[v].max(q[1]);
+                }
+                lo[*axis] = *from;
+                hi[*axis] = *to;
+                (lo, hi)
+            }
+            Shape::Slab { axis, from, to } if *axis < 3 => {
+                let (mut lo, mut hi) = ([-inf; 3], [inf; 3]);
+                lo[*axis] = *from;
+                hi[*axis] = *to;
+                (lo, hi)
+            }
+            _ => ([-inf; 3], [inf; 3]),
+        }
+    }
+
+    /// Checks the shape is well formed: finite numbers, min < max, radius > 0, length > 0, polygon >= 3 vertices with nonzero area, axis < 3, from < to. Error text says what is wrong, e.g. "cylinder radius must be > 0 (got -1)".
+    pub fn validate(&self) -> Result<(), String> {
+        let kind = self.kind();
+        let pos = |what: &str, x: f64| (x > 0.0, format!("{kind} {what} must be > 0 (got {x})"));
+        let axis_ok = |a: usize| (a < 3, format!("{kind} axis must be 0, 1 or 2 (got {a})"));
+        let range = |f: f64, t: f64| (f < t, format!("{kind} from must be < to (got {f} >= {t})"));
+        let (numbers, checks): (Vec<f64>, Vec<(bool, String)>) = match self {
+            Shape::Box { min, max } => {
+                let order = |e: usize| (min[e], max[e], AXES[e]);
+                let msg = |(a, b, x)| format!("box min must be < max in {x} (got {a} >= {b})");
+                let checks = (0..3).map(|e| (min[e] < max[e], msg(order(e))));
+                ([*min, *max].concat(), checks.collect())
+            }
+            Shape::Cylinder {
+                base,
+                axis,
+                length,
+                radius,
+            } => {
+                let dir = (
+                    dot(*axis, *axis) > 0.0,
+                    "cylinder axis must be nonzero".into(),
+                );
+                let numbers = [&base[..], axis, &[*length, *radius]].concat();
+                (
+                    numbers,
+                    vec![dir, pos("length", *length), pos("radius", *radius)],
+                )
+            }
+            Shape::Sphere { center, radius } => (
+                [&center[..], &[*radius]].concat(),
+                vec![pos("radius", *radius)],
+            ),
+            Shape::Prism {
+                axis,
+                polygon,
+                from,
+                to,
+            } => {
+                let ((lo, hi), (u, v)) = (self.bounds(), plane_axes(*axis));
+                let scale = (hi[u] - lo[u]).max(hi[v] - lo[v]);
+                let area = polygon_area(polygon).abs() > 1e-12 * scale * scale;
+                let n = polygon.len();
+                let count = format!("prism polygon needs at least 3 vertices (got {n})");
+                let checks = vec![
+                    axis_ok(*axis),
+                    range(*from, *to),
+                    (n >= 3, count),
+                    (area, "prism polygon has zero area".into()),
+                ];
+                ([&polygon.concat()[..], &[*from, *to]].concat(), checks)
+            }
+            Shape::Slab { axis, from, to } => {
+                (vec![*from, *to], vec![axis_ok(*axis), range(*from, *to)])
+            }
+        };
+        if !all_finite(&numbers) {
+            return Err(format!("{kind} has a non-finite number: {self:?}"));
+        }
+        checks
+            .into_iter()
+            .find(|c| !c.0)
+            .map_or(Ok(()), |c| Err(c.1))
+    }
+
+    fn kind(&self) -> &'static str {
+        match self {
+            Shape::Box { .. } => "box",
+            Shape::Cylinder { .. } => "cylinder",
+            Shape::Sphere { .. } => "sphere",
+            Shape::Prism { .. } => "prism",
+            Shape::Slab { .. } => "slab",
+        }
+    }
+}
+
+/// Simple-cubic lattice: sites at origin + spacing·(i + ½, j + ½, k + ½) for integers i, j, k, so a box [0, 200] with spacing 1 holds exactly 200 sites along that axis (site = centre of a cube of side `spacing`, volume spacing³) and box faces never cut through sites.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lattice {
+    pub spacing: f64,
+    pub origin: Vec3,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Op {
+    /// Fill every lattice site inside the shape with `material`; a site already filled takes the new material (later entries win).
+    Add { shape: Shape, material: u16 },
+    /// Remove every filled lattice site inside the shape (sites added by later Add entries come back).
+    Subtract { shape: Shape },
+}
+
+/// A line of particles from `from` to `to`: n = max(1, round(len / spacing)) particles at from + (k + ½)·(to − from)/n, each of volume area·len/n.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bar {
+    pub from: Vec3,
+    pub to: Vec3,
+    pub area: f64,
+    pub spacing: f64,
+    pub material: u16,
+}
+
+impl Bar {
+    /// A bar starting at `from` in direction `dir` (normalized internally) for `length`.
+    /// A zero `dir` yields non-finite end points, which `build` reports.
+    pub fn along(
+        from: Vec3,
+        dir: Vec3,
+        length: f64,
+        area: f64,
+        spacing: f64,
+        material: u16,
+    ) -> Bar {
+        let d = normalize(dir);
+        let to = [0, 1, 2].map(|e| from[e] + length * d[e]);
+        Bar {
+            from,
+            to,
+            area,
+            spacing,
+            material,
+        }
+    }
+
+    /// Direction from two angles in degrees: `azimuth` measured in the x–y plane from +x toward +y, `elevation` from that plane toward +z.
+    pub fn at_angle(
+        from: Vec3,
+        azimuth_deg: f64,
+        elevation_deg: f64,
+        length: f64,
+        area: f64,
+        spacing: f64,
+        material: u16,
+    ) -> Bar {
+        let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
+        let dir = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
+        Bar::along(from, dir, length, area, spacing, material)
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        if !all_finite(&[self.from.as_slice(), self.to.as_slice()].concat()) {
+            return Err(format!(
+                "bar end points must be finite (got {:?} to {:?})",
+                self.from, self.to
+            ));
+        }
+        for (what, x) in [("area", self.area), ("spacing", self.spacing)] {
+            if !(x.is_finite() && x > 0.0) {
+                return Err(format!("bar {what} must be finite and > 0 (got {x})"));
+            }
+        }
+        if self.from == self.to {
+            return Err("bar has zero length (from == to)".into());
+        }
+        Ok(())
+    }
+
+    fn length(&self) -> f64 {
+        let d = sub(self.to, self.from);
+        dot(d, d).sqrt()
+    }
+
+    fn count(&self) -> f64 {
+        (self.length() / self.spacing).round().max(1.0)
+    }
+}
+
+/// The reference particle cloud, in a deterministic order: lattice particles first in (z, y, x) lexicographic order of their site index (x fastest), then bar particles in bar order. Global id = index.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Cloud {
+    pub position: Vec<Vec3>,
+    pub volume: Vec<f64>,
+    pub material: Vec<u16>,
+    /// Lattice spacing (or bar particle spacing) of each particle: partial-volume correction and time-step estimates need it.
+    /// For bar particles this is the realised spacing len/n, not the requested one.
+    pub spacing: Vec<f64>,
+}
+
+impl Cloud {
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+}
+
+/// `message` is the complete user-facing text; `entry`/`bar` let callers point at the deck line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeometryError {
+    /// Index into ops (Some) or None for the whole scene.
+    pub entry: Option<usize>,
+    pub bar: Option<usize>,
+    pub message: String,
+}
+
+impl fmt::Display for GeometryError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for GeometryError {}
+
+fn scene_err(message: String) -> GeometryError {
+    GeometryError {
+        entry: None,
+        bar: None,
+        message,
+    }
+}
+
+/// Site keys are [k, j, i] so BTreeMap order is the documented (z, y, x) order, x fastest.
+type Key = [i64; 3];
+
+/// Keys of all sites in inclusive index ranges given per axis (x, y, z).
+fn sites(r: [(f64, f64); 3]) -> impl Iterator<Item = Key> {
+    let r = r.map(|(a, b)| a as i64..=b as i64);
+    let (rx, ry) = (r[0].clone(), r[1].clone());
+    r[2].clone().flat_map(move |k| {
+        let rx = rx.clone();
+        ry.clone()
+            .flat_map(move |j| rx.clone().map(move |i| [k, j, i]))
+    })
+}
+
+/// Applies `ops` in order on the lattice, then adds the bars; see the module doc for the
+/// overlap rules. Each Add visits only the sites in its shape's bounding box; bar/site overlap
+/// is found by indexing the lattice around each bar particle, O(M log N) rather than O(N·M).
+pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, GeometryError> {
+    let (s, o) = (lattice.spacing, lattice.origin);
+    if !(s.is_finite() && s > 0.0 && all_finite(&o)) {
+        return Err(scene_err(format!(
+            "lattice spacing must be finite and > 0, origin finite (got spacing {s}, origin {o:?})"
+        )));
+    }
+    let tol = 1e-9 * s;
+    let site = |key: &Key| [0, 1, 2].map(|e| o[e] + s * (key[2 - e] as f64 + 0.5));
+    // Index ranges (padded by one) of the sites covering [lo, hi]; inside tests trim them.
+    let range = |lo: Vec3, hi: Vec3| {
+        let idx = |x: f64, e: usize| (x - o[e]) / s - 0.5;
+        [0, 1, 2].map(|e| (idx(lo[e], e).floor() - 1.0, idx(hi[e], e).ceil() + 1.0))
+    };
+    let mut filled: BTreeMap<Key, u16> = BTreeMap::new();
+    for (n, op) in ops.iter().enumerate() {
+        let (Op::Add { shape, .. } | Op::Subtract { shape }) = op;
+        let kind = shape.kind();
+        let err = |m: &str| GeometryError {
+            entry: Some(n),
+            bar: None,
+            message: format!("geometry entry {n} ({kind}){m}"),
+        };
+        shape.validate().map_err(|m| err(&format!(": {m}")))?;
+        let Op::Add { material, .. } = op else {
+            filled.retain(|key, _| !shape.contains_tol(site(key), tol));
+            continue;
+        };
+        let (lo, hi) = shape.bounds();
+        if !all_finite(&[lo, hi].concat()) {
+            return Err(err(&format!(
+                " cannot be added: {kind} is unbounded; use it in regions or Subtract only"
+            )));
+        }
+        let r = range(lo, hi);
+        if r.iter().map(|(a, b)| b - a + 1.0).product::<f64>() > u32::MAX as f64 {
+            return Err(err(" spans more than u32::MAX lattice sites"));
+        }
+        let mut selected = 0usize;
+        for key in sites(r).filter(|key| shape.contains_tol(site(key), tol)) {
+            filled.insert(key, *material);
+            selected += 1;
+        }
+        if selected == 0 {
+            let m = " selects no lattice site: it is smaller than the spacing or outside";
+            return Err(err(m));
+        }
+    }
+
+    let mut total = filled.len() as f64;
+    for (b, bar) in bars.iter().enumerate() {
+        let message = |m| format!("bar {b}: {m}");
+        let err = |m| GeometryError {
+            entry: None,
+            bar: Some(b),
+            message: message(m),
+        };
+        bar.validate().map_err(err)?;
+        total += bar.count();
+    }
+    if total > u32::MAX as f64 {
+        return Err(scene_err(format!(
+            "the scene has {total} particles, over u32::MAX"
+        )));
+    }
+    let mut bar_particles = Vec::new();
+    let rm = 0.25 * s;
+    for bar in bars {
+        let n = bar.count();
+        let (step, ds) = (sub(bar.to, bar.from).map(|d| d / n), bar.length() / n);
+        for k in 0..n as usize {
+            let p = [0, 1, 2].map(|e| bar.from[e] + (k as f64 + 0.5) * step[e]);
+            for key in sites(range(p.map(|x| x - rm), p.map(|x| x + rm))) {
+                let d = sub(site(&key), p);
+                if dot(d, d) < rm * rm {
+                    filled.remove(&key);
+                }
+            }
+            bar_particles.push((p, bar.area * ds, bar.material, ds));
+        }
+    }
+
+    let mut cloud = Cloud::default();
+    let lattice_particles = filled.iter().map(|(key, &m)| (site(key), s * s * s, m, s));
+    for (p, volume, material, spacing) in lattice_particles.chain(bar_particles) {
+        cloud.position.push(p);
+        cloud.volume.push(volume);
+        cloud.material.push(material);
+        cloud.spacing.push(spacing);
+    }
+    if cloud.is_empty() {
+        let m = "the scene has no particles: nothing was added, or every site was subtracted";
+        return Err(scene_err(m.into()));
+    }
+    Ok(cloud)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(s: f64, ops: &[Op], bars: &[Bar]) -> Result<Cloud, GeometryError> {
+        build(
+            &Lattice {
+                spacing: s,
+                origin: [0.0; 3],
+            },
+            ops,
+            bars,
+        )
+    }
+    fn add(shape: Shape, material: u16) -> Op {
+        Op::Add { shape, material }
+    }
+    fn bx(min: Vec3, max: Vec3) -> Shape {
+        Shape::Box { min, max }
+    }
+    fn cube(a: f64, b: f64) -> Shape {
+        bx([a; 3], [b; 3])
+    }
+    fn prism(axis: usize, polygon: Vec<[f64; 2]>) -> Shape {
+        Shape::Prism {
+            axis,
+            polygon,
+            from: 1.0,
+            to: 6.0,
+        }
+    }
+    fn cyl(base: Vec3, axis: Vec3, length: f64, radius: f64) -> Shape {
+        Shape::Cylinder {
+            base,
+            axis,
+            length,
+            radius,
+        }
+    }
+    fn x_bar(from: Vec3, length: f64, area: f64, spacing: f64) -> Bar {
+        Bar::along(from, [1.0, 0.0, 0.0], length, area, spacing, 9)
+    }
+
+    #[test]
+    fn box_300k_exact_and_ordered() {
+        let c = run(1.0, &[add(bx([0.0; 3], [200.0, 50.0, 30.0]), 7)], &[]).unwrap();
+        assert_eq!(c.len(), 300_000);
+        assert!(c.volume.iter().chain(&c.spacing).all(|&v| v == 1.0));
+        assert!(c.material.iter().all(|&m| m == 7));
+        let at = |n: usize| c.position[n];
+        assert_eq!(
+            [at(0), at(1), at(200)],
+            [[0.5; 3], [1.5, 0.5, 0.5], [0.5, 1.5, 0.5]]
+        );
+        assert_eq!(
+            [at(10_000), at(299_999)],
+            [[0.5, 0.5, 1.5], [199.5, 49.5, 29.5]]
+        );
+    }
+
+    #[test]
+    fn box_minus_box() {
+        let c = run(
+            1.0,
+            &[
+                add(cube(0.0, 10.0), 1),
+                Op::Subtract {
+                    shape: cube(3.0, 7.0),
+                },
+            ],
+            &[],
+        );
+        assert_eq!(c.unwrap().len(), 1000 - 64);
+    }
+
+    #[test]
+    fn cylinder_along_x_matches_brute_force() {
+        let c = run(
+            1.0,
+            &[add(cyl([0.0; 3], [2.0, 0.0, 0.0], 12.0, 3.0), 1)],
+            &[],
+        )
+        .unwrap();
+        let h = |n: i32| n as f64 + 0.5;
+        let brute = (-20..20)
+            .flat_map(|i| (-20..20).flat_map(move |j| (-20..20).map(move |k| (h(i), h(j), h(k)))))
+            .filter(|&(x, y, z)| (0.0..=12.0).contains(&x) && y * y + z * z <= 9.0)
+            .count();
+        assert_eq!((c.len(), brute), (12 * 32, 12 * 32));
+    }
+
+    #[test]
+    fn oblique_cylinder_inside() {
+        let (base, axis, len, r, s) = ([1.0, 2.0, 3.0], [1.0, 1.0, 1.0], 10.0, 2.5, 0.5);
+        let c = run(s, &[add(cyl(base, axis, len, r), 1)], &[]).unwrap();
+        for p in &c.position {
+            let (d, a) = (sub(*p, base), normalize(axis));
+            let t = dot(d, a);
+            assert!((-1e-9..=len + 1e-9).contains(&t) && dot(d, d) - t * t <= r * r + 1e-9);
+        }
+        let expected = std::f64::consts::PI * r * r * len / (s * s * s);
+        assert!(
+            (c.len() as f64 - expected).abs() < 0.05 * expected,
+            "{}",
+            c.len()
+        );
+    }
+
+    #[test]
+    fn prism_square_equals_box_on_every_axis() {
+        let poly = vec![[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]];
+        let boxes = [
+            [1.0, 0.0, 0.0, 6.0, 4.0, 3.0],
+            [0.0, 1.0, 0.0, 3.0, 6.0, 4.0],
+        ];
+        let boxes = [boxes[0], boxes[1], [0.0, 0.0, 1.0, 4.0, 3.0, 6.0]];
+        for (axis, b) in boxes.into_iter().enumerate() {
+            let p = run(0.5, &[add(prism(axis, poly.clone()), 1)], &[]).unwrap();
+            let b = run(
+                0.5,
+                &[add(bx([b[0], b[1], b[2]], [b[3], b[4], b[5]]), 1)],
+                &[],
+            );
+            assert_eq!((p.len(), &p), (480, &b.unwrap()), "axis {axis}");
+        }
+    }
+
+    #[test]
+    fn prism_l_shape_and_orientation() {
+        let mut poly = vec![
+            [0.0, 0.0],
+            [6.0, 0.0],
+            [6.0, 2.0],
+            [2.0, 2.0],
+            [2.0, 5.0],
+            [0.0, 5.0],
+        ];
+        let ccw = run(1.0, &[add(prism(2, poly.clone()), 1)], &[]).unwrap();
+        assert_eq!(ccw.len(), (12 + 6) * 5);
+        assert!(!ccw.position.iter().any(|p| p[0] > 2.0 && p[1] > 2.0));
+        poly.reverse();
+        assert_eq!(run(1.0, &[add(prism(2, poly), 1)], &[]).unwrap(), ccw);
+    }
+
+    #[test]
+    fn later_add_wins_and_subtract_then_add_restores() {
+        let c = run(1.0, &[add(cube(0.0, 10.0), 1), add(cube(2.0, 4.0), 2)], &[]).unwrap();
+        assert_eq!(
+            (c.len(), c.material.iter().filter(|&&m| m == 2).count()),
+            (1000, 8)
+        );
+        let plain = run(1.0, &[add(cube(0.0, 10.0), 1)], &[]).unwrap();
+        let hole = Op::Subtract {
+            shape: cube(2.0, 5.0),
+        };
+        let ops = [add(cube(0.0, 10.0), 1), hole, add(cube(2.0, 5.0), 1)];
+        assert_eq!(run(1.0, &ops, &[]).unwrap(), plain);
+    }
+
+    #[test]
+    fn slab_is_half_open_and_only_subtracts() {
+        let slab = Shape::Slab {
+            axis: 2,
+            from: 0.0,
+            to: 2.5,
+        };
+        assert!(slab.contains([9.0, 9.0, 0.0]) && !slab.contains([9.0, 9.0, 2.5]));
+        let ops = [
+            add(cube(0.0, 10.0), 1),
+            Op::Subtract {
+                shape: slab.clone(),
+            },
+        ];
+        assert_eq!(run(0.5, &ops, &[]).unwrap().len(), 8000 - 400 * 5);
+        let e = run(1.0, &[add(slab, 1)], &[]).unwrap_err();
+        assert!(e.message.contains("slab is unbounded"), "{e}");
+    }
+
+    #[test]
+    fn bar_particles() {
+        let bar = Bar::along([1.0, 2.0, 3.0], [0.0, 0.0, 2.0], 10.0, 0.2, 0.5, 3);
+        let c = run(1.0, &[], &[bar]).unwrap();
+        assert_eq!(c.len(), 20);
+        for (k, p) in c.position.iter().enumerate() {
+            assert_eq!(*p, [1.0, 2.0, 3.0 + 0.5 * (k as f64 + 0.5)]);
+        }
+        assert!(c.volume.iter().all(|&v| (v - 0.1).abs() < 1e-15));
+        assert!(c.material.iter().all(|&m| m == 3) && c.spacing.iter().all(|&d| d == 0.5));
+        let close = |a: Vec3, b: Vec3| (0..3).all(|e| (a[e] - b[e]).abs() < 1e-12);
+        let angled = |az, el| Bar::at_angle([0.0; 3], az, el, 2.0, 1.0, 1.0, 0).to;
+        assert!(close(angled(0.0, 90.0), [0.0, 0.0, 2.0]));
+        assert!(close(angled(90.0, 0.0), [0.0, 2.0, 0.0]));
+        assert!(close(angled(180.0, 0.0), [-2.0, 0.0, 0.0]));
+    }
+
+    #[test]
+    fn bar_removes_only_coincident_sites() {
+        let ops = [add(cube(0.0, 10.0), 1)];
+        let c = run(1.0, &ops, &[x_bar([0.0, 5.5, 5.5], 10.0, 0.1, 1.0)]).unwrap();
+        assert_eq!(c.len(), 1000 - 10 + 10);
+        assert_eq!(c.material.iter().filter(|&&m| m == 9).count(), 10);
+        assert!(c.position.contains(&[3.5, 4.5, 5.5]) && c.position.contains(&[3.5, 5.5, 6.5]));
+        // A bar between site rows, or with particles between sites, removes nothing.
+        let c = run(1.0, &ops, &[x_bar([0.0, 5.0, 5.0], 10.0, 0.1, 1.0)]).unwrap();
+        assert_eq!(c.len(), 1010);
+        let c = run(1.0, &ops, &[x_bar([0.5, 5.5, 5.5], 9.0, 0.1, 1.0)]).unwrap();
+        assert_eq!(c.len(), 1009);
+    }
+
+    #[test]
+    fn errors() {
+        let bad = cyl([0.0; 3], [1.0, 0.0, 0.0], 1.0, -1.0);
+        assert_eq!(
+            bad.validate().unwrap_err(),
+            "cylinder radius must be > 0 (got -1)"
+        );
+        let e = run(1.0, &[add(cube(0.0, 9.0), 1), add(bad, 1)], &[]).unwrap_err();
+        assert_eq!((e.entry, e.bar), (Some(1), None));
+        let msg = "geometry entry 1 (cylinder): cylinder radius must be > 0 (got -1)";
+        assert_eq!(e.to_string(), msg);
+        let e = prism(2, vec![]).validate().unwrap_err();
+        assert!(e.contains("at least 3 vertices"), "{e}");
+        let e = prism(2, vec![[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]])
+            .validate()
+            .unwrap_err();
+        assert!(e.contains("zero area"), "{e}");
+        let ops = [
+            add(cube(0.0, 9.0), 1),
+            add(cube(0.0, 9.0), 1),
+            add(cube(0.1, 0.2), 1),
+        ];
+        let msg = "geometry entry 2 (box) selects no lattice site: it is smaller than the spacing or outside";
+        assert_eq!(run(1.0, &ops, &[]).unwrap_err().message, msg);
+        let ops = [
+            add(cube(0.0, 4.0), 1),
+            Op::Subtract {
+                shape: cube(-1.0, 5.0),
+            },
+        ];
+        let e = run(1.0, &ops, &[]).unwrap_err();
+        assert!(
+            e.entry.is_none() && e.message.contains("no particles"),
+            "{e}"
+        );
+        let e = run(0.0, &ops[..1], &[]).unwrap_err();
+        assert!(e.entry.is_none() && e.message.contains("spacing"), "{e}");
+        let bad = x_bar([0.0; 3], 1.0, 0.0, 1.0);
+        let e = run(1.0, &ops[..1], &[bad.clone(), bad]).unwrap_err();
+        assert_eq!((e.entry, e.bar), (None, Some(0)));
+        assert!(e.message.contains("area"), "{e}");
+        let e = run(1.0, &[add(cube(0.0, 1e9), 1)], &[]).unwrap_err();
+        assert!(e.message.contains("u32::MAX"), "{e}");
+    }
+}

@@ -1,0 +1,24 @@
+//! PDQ: a peridynamics engine for cracking of plain, reinforced and prestressed concrete.
+//!
+//! Data flows one way: [`deck`] (TOML) → [`geometry`] → [`particles`] and [`bonds`] →
+//! [`simulation`] (the step loop) → [`output`]. Models live in `models/`, one file each, and
+//! see nothing but the [`model::Model`] interface.
+
+pub mod attributes;
+pub mod bench;
+pub mod bonds;
+pub mod boundary;
+pub mod cells;
+pub mod deck;
+pub mod forces;
+pub mod geometry;
+pub mod model;
+#[path = "../models/mod.rs"]
+pub mod models;
+pub mod output;
+pub mod particles;
+pub mod run;
+pub mod setup;
+pub mod simulation;
+pub mod timing;
+pub mod units;

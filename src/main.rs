@@ -1,0 +1,137 @@
+//! The `pdq` command line.
+
+use clap::{Parser, Subcommand};
+use pdq::{bench, deck, run};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "pdq",
+    version,
+    about = "PDQ peridynamics: cracking of plain, reinforced and prestressed concrete"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Run a deck: time history, frames and a timing table in the output directory.
+    Run {
+        deck: PathBuf,
+        /// Run this many steps instead of the deck's.
+        #[arg(long)]
+        steps: Option<u64>,
+        /// Write output here instead of the deck's directory.
+        #[arg(long)]
+        output: Option<PathBuf>,
+        /// Print nothing but errors.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Check a deck: particles, bonds, memory, time step, and an estimated run time.
+    Check { deck: PathBuf },
+    /// List the models and the attributes each declares.
+    Models,
+    /// Time the standard benchmark scene (shared/bench): µs per particle-step.
+    Bench {
+        #[arg(long, default_value = "pmb")]
+        model: String,
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+        #[arg(long, default_value_t = 200)]
+        steps: u64,
+        /// Lattice cells per edge ((n+1)³ particles); 40 is the standard scene.
+        #[arg(long, default_value_t = 40)]
+        n: usize,
+        /// Also run LAMMPS (`lmp`, or $PDQ_LMP) on the same scene.
+        #[arg(long)]
+        peer: bool,
+        /// Repetitions of the generic-vs-hand force pass comparison.
+        #[arg(long, default_value_t = 7)]
+        repeat: usize,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Cmd::Run {
+            deck: path,
+            steps,
+            output,
+            quiet,
+        } => deck::load(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|scene| {
+                run::run(
+                    &scene,
+                    &run::RunOptions {
+                        steps,
+                        output,
+                        quiet,
+                    },
+                )
+            })
+            .map(|_| ()),
+        Cmd::Check { deck: path } => deck::load(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|scene| run::check(&scene))
+            .map(|s| print!("{s}")),
+        Cmd::Models => {
+            print!("{}", models_text());
+            Ok(())
+        }
+        Cmd::Bench {
+            model,
+            threads,
+            steps,
+            n,
+            peer,
+            repeat,
+        } => bench::run(&bench::BenchOptions {
+            model,
+            threads,
+            steps,
+            n,
+            peer,
+            repeat,
+        })
+        .map(|s| print!("{s}")),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn models_text() -> String {
+    let fields = |f: &[pdq::attributes::Field]| {
+        if f.is_empty() {
+            "()".to_string()
+        } else {
+            f.iter()
+                .map(|f| format!("{}[{}]", f.name, f.len))
+                .collect::<Vec<_>>()
+                .join(" ")
+        }
+    };
+    let mut s = String::new();
+    for m in pdq::models::info() {
+        s.push_str(&format!("{}: {}\n", m.name, m.summary));
+        s.push_str(&format!("  alter  {}\n", fields(m.alter)));
+        s.push_str(&format!("  fixed  {}\n", fields(m.fixed)));
+        s.push_str(&format!("  bond   {}\n", fields(m.bond)));
+        s.push_str(&format!("  state  {}\n", fields(m.state)));
+        s.push_str(&format!("  force  {}\n", fields(m.force)));
+        for (k, v) in m.options {
+            s.push_str(&format!("  option {k}: {v}\n"));
+        }
+    }
+    s
+}

@@ -1,0 +1,286 @@
+//! The interface between the engine and a model file in `models/`.
+//!
+//! A model is physics only: it declares its data (see [`crate::attributes`]) and says what one
+//! bond does. The engine owns every loop, the decomposition and all I/O, and is generic over
+//! `M: Model`, so each model gets its own monomorphized step with no dynamic dispatch per bond.
+
+use crate::attributes::Attributes;
+
+/// What a material is made of, as far as a model needs to know to pick a bond law.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MaterialKind {
+    /// A generic elastic-brittle solid.
+    Solid,
+    /// Plain concrete (the thesis's `ConcConc` law).
+    Concrete,
+    /// Reinforcing or prestressing steel.
+    Steel,
+}
+
+impl MaterialKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            MaterialKind::Solid => "solid",
+            MaterialKind::Concrete => "concrete",
+            MaterialKind::Steel => "steel",
+        }
+    }
+}
+
+/// A material as the deck describes it, already in the deck's unit system. Models read the
+/// properties they need and report the ones that are missing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub kind: MaterialKind,
+    pub density: f64,
+    pub youngs_modulus: Option<f64>,
+    pub poisson_ratio: Option<f64>,
+    pub bulk_modulus: Option<f64>,
+    pub micromodulus: Option<f64>,
+    pub critical_stretch: Option<f64>,
+    pub fracture_energy: Option<f64>,
+    pub tensile_stretch: Option<f64>,
+    pub compressive_stretch: Option<f64>,
+    pub yield_stretch: Option<f64>,
+    pub failure_stretch: Option<f64>,
+    pub compressive_strength: Option<f64>,
+}
+
+impl Material {
+    /// A material with only a name, kind and density; the rest is filled in by the caller.
+    pub fn new(name: &str, kind: MaterialKind, density: f64) -> Self {
+        Material {
+            name: name.to_string(),
+            kind,
+            density,
+            youngs_modulus: None,
+            poisson_ratio: None,
+            bulk_modulus: None,
+            micromodulus: None,
+            critical_stretch: None,
+            fracture_energy: None,
+            tensile_stretch: None,
+            compressive_stretch: None,
+            yield_stretch: None,
+            failure_stretch: None,
+            compressive_strength: None,
+        }
+    }
+
+    /// A property the model cannot do without.
+    pub fn require(&self, value: Option<f64>, key: &str, model: &str) -> Result<f64, String> {
+        value.ok_or_else(|| format!("material '{}' needs '{key}' for model '{model}'", self.name))
+    }
+}
+
+/// Everything a model is built from.
+#[derive(Clone, Debug)]
+pub struct ModelBuild<'a> {
+    pub materials: &'a [Material],
+    pub horizon: f64,
+    pub spacing: f64,
+    /// Model-specific numeric options from the deck's `[model.options]`; a model rejects
+    /// names it does not know (see [`check_options`]).
+    pub options: &'a [(String, f64)],
+}
+
+impl ModelBuild<'_> {
+    pub fn option(&self, name: &str) -> Option<f64> {
+        self.options
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| *v)
+    }
+}
+
+/// Rejects option names a model does not declare, naming them and listing the known ones.
+pub fn check_options(
+    model: &str,
+    known: &[(&str, &str)],
+    given: &[(String, f64)],
+) -> Result<(), String> {
+    for (k, _) in given {
+        if !known.iter().any(|(n, _)| n == k) {
+            let names: Vec<&str> = known.iter().map(|(n, _)| *n).collect();
+            return Err(format!(
+                "model '{model}' has no option '{k}' (its options: {})",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Reference data of a bond, fixed when families are found.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BondGeom {
+    /// |ξ|, the reference bond length.
+    pub length: f64,
+    /// Partial-volume factor β ∈ (0, 1] scaling the partner volume (THEORY.md §6).
+    pub beta: f64,
+}
+
+/// One end of a bond as the model sees it.
+pub struct Side<'a, M: Model> {
+    pub x0: &'a [f64; 3],
+    pub volume: f64,
+    pub material: u16,
+    pub alter: &'a M::Alter,
+    pub fixed: &'a M::Fixed,
+    pub state: &'a M::State,
+}
+
+impl<M: Model> Side<'_, M> {
+    /// Current position: by convention the first three values of the alterable record.
+    #[inline(always)]
+    pub fn pos(&self) -> [f64; 3] {
+        let a = self.alter.as_slice();
+        [a[0], a[1], a[2]]
+    }
+}
+
+/// A peridynamic model: data declarations plus the physics of one bond.
+///
+/// Layout convention for `Alter`: the first `Force::LEN` values are the generalized
+/// coordinates (current position first), the next `Force::LEN` their velocities; anything after
+/// that is free for the model. The integrators rely on it, so a model needs no integration code.
+pub trait Model: Sized + Send + Sync + 'static {
+    /// The name a deck uses (`[model] name = "…"`).
+    const NAME: &'static str;
+    /// One line for `pdq models`.
+    const SUMMARY: &'static str;
+    /// Options accepted in `[model.options]`: name and meaning.
+    const OPTIONS: &'static [(&'static str, &'static str)] = &[];
+
+    /// Changes during a run: generalized coordinates, then their velocities, then extras.
+    type Alter: Attributes;
+    /// Constant per-particle data beyond the engine's reference position, volume, material.
+    type Fixed: Attributes;
+    /// History kept on every bond (plastic stretch …); the engine keeps the broken flag.
+    type Bond: Attributes;
+    /// Per-particle value summed over bonds before forces (LPS dilatation); `()` = no pass.
+    type State: Attributes;
+    /// One generalized force per integrated degree of freedom.
+    type Force: Attributes;
+
+    fn build(b: &ModelBuild) -> Result<Self, String>;
+
+    /// Constant data of a particle.
+    fn fixed(&self, _material: u16, _volume: f64) -> Self::Fixed {
+        Self::Fixed::default()
+    }
+
+    /// Mass (or inertia) of each generalized degree of freedom.
+    fn inertia(&self, material: u16, volume: f64, fixed: &Self::Fixed) -> Self::Force;
+
+    /// Stiffness C_ij = c/|ξ| of a bond for the Silling–Askari stable time step (THEORY.md §4).
+    fn bond_stiffness(&self, mi: u16, mj: u16, geom: &BondGeom) -> f64;
+
+    /// Contribution of an intact bond to both ends' state (only called if `State` is not `()`).
+    fn state(
+        &self,
+        _i: &Side<Self>,
+        _j: &Side<Self>,
+        _geom: &BondGeom,
+        _bond: &Self::Bond,
+    ) -> (Self::State, Self::State) {
+        (Self::State::default(), Self::State::default())
+    }
+
+    /// Turns a particle's summed state into its final value (e.g. θ = 3/m·Σ…).
+    fn finish_state(&self, _state: &mut Self::State, _fixed: &Self::Fixed) {}
+
+    /// Generalized forces on both ends of an intact bond, already multiplied by both volumes.
+    /// `None` means the bond breaks now: the engine marks it and never calls it again.
+    fn pair(
+        &self,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+        bond: &mut Self::Bond,
+    ) -> Option<(Self::Force, Self::Force)>;
+
+    /// Elastic energy stored in an intact bond (whole bond, both volumes included).
+    fn energy(&self, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, bond: &Self::Bond) -> f64;
+}
+
+/// Bond stretch and the current bond vector: shared by every bond-based law.
+#[inline(always)]
+pub fn stretch<M: Model>(i: &Side<M>, j: &Side<M>, geom: &BondGeom) -> (f64, [f64; 3], f64) {
+    let (a, b) = (i.pos(), j.pos());
+    let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+    ((r - geom.length) / geom.length, y, r)
+}
+
+/// Something to do with a model chosen by name at run time: the one place where a deck's
+/// string becomes a concrete type, after which everything is monomorphized.
+pub trait ModelVisitor {
+    type Output;
+    fn visit<M: Model>(self, model: M) -> Self::Output;
+}
+
+/// What `pdq models` prints about a model.
+#[derive(Clone, Debug)]
+pub struct ModelInfo {
+    pub name: &'static str,
+    pub summary: &'static str,
+    pub options: &'static [(&'static str, &'static str)],
+    pub alter: &'static [crate::attributes::Field],
+    pub fixed: &'static [crate::attributes::Field],
+    pub bond: &'static [crate::attributes::Field],
+    pub state: &'static [crate::attributes::Field],
+    pub force: &'static [crate::attributes::Field],
+}
+
+impl ModelInfo {
+    pub fn of<M: Model>() -> Self {
+        ModelInfo {
+            name: M::NAME,
+            summary: M::SUMMARY,
+            options: M::OPTIONS,
+            alter: <M::Alter as Attributes>::FIELDS,
+            fixed: <M::Fixed as Attributes>::FIELDS,
+            bond: <M::Bond as Attributes>::FIELDS,
+            state: <M::State as Attributes>::FIELDS,
+            force: <M::Force as Attributes>::FIELDS,
+        }
+    }
+}
+
+/// Generates the lookup of models by name (`names`, `info`, `visit`) from a list of types.
+/// Used once, in `models/mod.rs`.
+#[macro_export]
+macro_rules! model_registry {
+    ($($ty:ty),+ $(,)?) => {
+        /// Names a deck may use in `[model] name = …`.
+        pub fn names() -> Vec<&'static str> {
+            vec![$(<$ty as $crate::model::Model>::NAME),+]
+        }
+
+        /// Declared data of every model.
+        pub fn info() -> Vec<$crate::model::ModelInfo> {
+            vec![$($crate::model::ModelInfo::of::<$ty>()),+]
+        }
+
+        /// Builds the model called `name` and hands it to `visitor`.
+        pub fn visit<V: $crate::model::ModelVisitor>(
+            name: &str,
+            build: &$crate::model::ModelBuild,
+            visitor: V,
+        ) -> Result<V::Output, String> {
+            $(
+                if name == <$ty as $crate::model::Model>::NAME {
+                    let model = <$ty as $crate::model::Model>::build(build)?;
+                    return Ok(visitor.visit(model));
+                }
+            )+
+            Err(format!("unknown model '{}' (known models: {})", name, names().join(", ")))
+        }
+    };
+}

@@ -1,0 +1,233 @@
+//! From a checked deck to a ready-to-step simulation: geometry → particles → bonds → time step
+//! → boundary conditions and loads.
+
+use crate::attributes::Attributes;
+use crate::bonds::BondList;
+use crate::boundary::{Constraint, Load};
+use crate::cells::CellGrid;
+use crate::deck::{DeckError, LoadKind, Region, RunLength, Scene};
+use crate::geometry;
+use crate::model::{Model, ModelBuild, ModelVisitor};
+use crate::particles::Particles;
+use crate::simulation::{stable_time_step, Simulation};
+use std::time::Instant;
+
+/// A simulation built from a deck, with what the deck's checks found.
+pub struct Setup<M: Model> {
+    pub sim: Simulation<M>,
+    /// Silling–Askari bound and the particle (store index) that sets it.
+    pub dt_critical: f64,
+    pub dt_critical_particle: usize,
+    pub steps: u64,
+    /// Probe name and the store index of the particle nearest to it.
+    pub probes: Vec<(String, usize)>,
+    pub seconds: f64,
+}
+
+/// Builds the model named by the deck and hands it to `visitor`.
+pub fn with_model<V: ModelVisitor>(scene: &Scene, visitor: V) -> Result<V::Output, DeckError> {
+    let build = ModelBuild {
+        materials: &scene.materials,
+        horizon: scene.horizon,
+        spacing: scene.spacing,
+        options: &scene.model_options,
+    };
+    crate::models::visit(&scene.model, &build, visitor)
+        .map_err(|e| scene.error(Some(scene.model_line), format!("[model] {e}")))
+}
+
+/// Store indices of the particles of a region, in store order.
+fn select<M: Model>(
+    p: &Particles<M>,
+    region: &Region,
+    gid_to_index: &[u32],
+) -> Result<Vec<u32>, String> {
+    let n = p.n_owned;
+    Ok(match region {
+        Region::All => (0..n as u32).collect(),
+        Region::Shape(s) => (0..n)
+            .filter(|&i| s.contains(p.x0[i]))
+            .map(|i| i as u32)
+            .collect(),
+        Region::Ids(ids) => {
+            let mut v = Vec::with_capacity(ids.len());
+            for &id in ids {
+                match gid_to_index.get(id as usize) {
+                    Some(&i) => v.push(i),
+                    None => {
+                        return Err(format!(
+                            "particle id {id} does not exist (ids run from 0 to {})",
+                            gid_to_index.len() - 1
+                        ))
+                    }
+                }
+            }
+            v.sort_unstable();
+            v.dedup();
+            v
+        }
+    })
+}
+
+pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
+    let start = Instant::now();
+    let cloud = geometry::build(&scene.lattice, &scene.ops, &scene.bars).map_err(|e| {
+        let line = e
+            .entry
+            .map(|k| scene.op_lines[k])
+            .or(e.bar.map(|k| scene.bar_lines[k]));
+        scene.error(line, e.message.clone())
+    })?;
+
+    // Store particles in cell order so that bond partners are near each other in memory.
+    let grid = CellGrid::covering(&cloud.position, scene.horizon);
+    let (_, _, order) = grid.bin(&cloud.position);
+    let gid: Vec<u32> = order.clone();
+    let x0 = order.iter().map(|&g| cloud.position[g as usize]).collect();
+    let volume = order.iter().map(|&g| cloud.volume[g as usize]).collect();
+    let material = order.iter().map(|&g| cloud.material[g as usize]).collect();
+    let mut gid_to_index = vec![0u32; gid.len()];
+    for (i, &g) in gid.iter().enumerate() {
+        gid_to_index[g as usize] = i as u32;
+    }
+    let mut particles = Particles::new(&model, gid, x0, volume, material);
+    let bonds = BondList::<M::Bond>::find(
+        &particles.x0,
+        particles.n_owned,
+        scene.horizon,
+        scene.spacing,
+        scene.partial_volume,
+    );
+
+    // Time step.
+    let (dt_critical, dt_critical_particle) = stable_time_step(&model, &particles, &bonds);
+    if !dt_critical.is_finite() {
+        return Err(scene.error(
+            None,
+            "no particle has a bond: the horizon is too small for the particle spacing",
+        ));
+    }
+    let dt = match scene.time.dt {
+        Some(dt) => {
+            if dt > dt_critical && !scene.time.force_dt {
+                return Err(scene.error(
+                    None,
+                    format!(
+                        "[time] dt = {dt:.4e} is above the stable time step {dt_critical:.4e} (Silling–Askari bound, set by particle {} at {:?}); lower dt, use safety_factor, or set force_dt = true to run anyway",
+                        particles.gid[dt_critical_particle], particles.x0[dt_critical_particle]
+                    ),
+                ));
+            }
+            dt
+        }
+        None => scene.time.safety_factor * dt_critical,
+    };
+    let steps = match scene.time.length {
+        RunLength::Steps(n) => n,
+        RunLength::Duration(d) => (d / dt).ceil() as u64,
+    };
+
+    // Initial velocities.
+    let nf = <M::Force as Attributes>::LEN;
+    for init in &scene.initial {
+        let sel = select(&particles, &init.region, &gid_to_index)
+            .map_err(|e| scene.error(Some(init.line), format!("initial: {e}")))?;
+        if sel.is_empty() {
+            return Err(scene.error(Some(init.line), "initial: the region selects no particle"));
+        }
+        for i in sel {
+            particles.alter[i as usize].as_mut_slice()[nf..nf + 3].copy_from_slice(&init.velocity);
+        }
+    }
+
+    // Boundary conditions and loads.
+    let mut constraints = Vec::new();
+    for b in &scene.boundaries {
+        let sel = select(&particles, &b.region, &gid_to_index)
+            .map_err(|e| scene.error(Some(b.line), format!("boundary '{}': {e}", b.name)))?;
+        if sel.is_empty() {
+            return Err(scene.error(
+                Some(b.line),
+                format!("boundary '{}': the region selects no particle", b.name),
+            ));
+        }
+        constraints.push(Constraint::new(
+            &b.name,
+            sel,
+            b.dofs.clone(),
+            b.motion.clone(),
+            b.history.clone(),
+        ));
+    }
+    let mut loads = Vec::new();
+    for l in &scene.loads {
+        let sel = select(&particles, &l.region, &gid_to_index)
+            .map_err(|e| scene.error(Some(l.line), format!("load '{}': {e}", l.name)))?;
+        if sel.is_empty() {
+            return Err(scene.error(
+                Some(l.line),
+                format!("load '{}': the region selects no particle", l.name),
+            ));
+        }
+        let volume_of = |i: &u32| particles.volume[*i as usize];
+        let (vector, weight): ([f64; 3], Vec<f64>) = match l.kind {
+            LoadKind::PerParticle(v) => (v, vec![1.0; sel.len()]),
+            LoadKind::Total(v) => {
+                let total: f64 = sel.iter().map(volume_of).sum();
+                (v, sel.iter().map(|i| volume_of(i) / total).collect())
+            }
+            LoadKind::BodyForce(v) => (v, sel.iter().map(volume_of).collect()),
+            LoadKind::Gravity(g) => (
+                g,
+                sel.iter()
+                    .map(|&i| 1.0 / particles.inv_inertia[i as usize].as_slice()[0])
+                    .collect(),
+            ),
+        };
+        loads.push(Load {
+            name: l.name.clone(),
+            particles: sel,
+            weight,
+            vector,
+            history: l.history.clone(),
+        });
+    }
+
+    // Probes: the particle nearest to each point.
+    let probes = scene
+        .probes
+        .iter()
+        .map(|pr| {
+            let nearest = (0..particles.n_owned)
+                .min_by(|&a, &b| {
+                    dist2(particles.x0[a], pr.at).total_cmp(&dist2(particles.x0[b], pr.at))
+                })
+                .unwrap_or(0);
+            (pr.name.clone(), nearest)
+        })
+        .collect();
+
+    let mut sim = Simulation::new(model, particles, bonds, dt);
+    sim.constraints = constraints;
+    sim.loads = loads;
+    sim.integrator = scene.time.integrator;
+    for c in &sim.constraints {
+        c.set_velocity(&mut sim.particles, 0.0, dt);
+    }
+    sim.compute_forces();
+    let seconds = start.elapsed().as_secs_f64();
+    sim.timing = crate::timing::Timing::default();
+    sim.timing.add(crate::timing::Phase::Setup, start.elapsed());
+    Ok(Setup {
+        sim,
+        dt_critical,
+        dt_critical_particle,
+        steps,
+        probes,
+        seconds,
+    })
+}
+
+fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
+}

@@ -1,0 +1,198 @@
+//! One procCube's time stepping: particles and bonds, forces, loads and constraints, integration.
+//!
+//! ```text
+//! kick → constrain → drift → exchange (forward) → [state pass → reverse-sum → finish]
+//!      → pair pass → reverse force sum → loads, constraints → kick → constrain
+//! ```
+//! The exchange points are where the wall method's ghost messages go; a single procCube with
+//! no periodic axis has no ghosts and [`Local`] does nothing there.
+
+use crate::attributes::Attributes;
+use crate::bonds::BondList;
+use crate::boundary::{Constraint, Load};
+use crate::forces;
+use crate::model::Model;
+use crate::particles::Particles;
+use crate::timing::{Phase, Timing};
+use std::time::Instant;
+
+/// Time integration of the generalized degrees of freedom.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// Velocity Verlet (half kick, drift, forces, half kick): second order, symplectic.
+    VelocityVerlet,
+    /// The thesis's scheme (appendix A.3.2): v += Δt·F/m, then x += Δt·v.
+    SemiImplicitEuler,
+}
+
+impl Integrator {
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::VelocityVerlet => "velocity-verlet",
+            Integrator::SemiImplicitEuler => "semi-implicit-euler",
+        }
+    }
+}
+
+/// Moves ghost data between procCubes at the points of the step where the wall method needs it.
+pub trait Exchange<M: Model> {
+    /// Alterable attributes of owned particles to their ghost copies.
+    fn forward(&mut self, _p: &mut Particles<M>) {}
+    /// Partial state sums on ghosts back to their owners (summed on arrival).
+    fn reverse_state(&mut self, _p: &mut Particles<M>) {}
+    /// Finished state of owned particles to their ghost copies.
+    fn forward_state(&mut self, _p: &mut Particles<M>) {}
+    /// Generalized forces on ghosts back to their owners (summed on arrival).
+    fn reverse_force(&mut self, _p: &mut Particles<M>) {}
+}
+
+/// One procCube, no ghosts: nothing to move.
+pub struct Local;
+impl<M: Model> Exchange<M> for Local {}
+
+pub struct Simulation<M: Model> {
+    pub model: M,
+    pub particles: Particles<M>,
+    pub bonds: BondList<M::Bond>,
+    pub constraints: Vec<Constraint>,
+    pub loads: Vec<Load>,
+    pub integrator: Integrator,
+    pub dt: f64,
+    pub time: f64,
+    pub step: u64,
+    pub timing: Timing,
+    pub exchange: Box<dyn Exchange<M> + Send>,
+}
+
+impl<M: Model> Simulation<M> {
+    pub fn new(model: M, particles: Particles<M>, bonds: BondList<M::Bond>, dt: f64) -> Self {
+        Simulation {
+            model,
+            particles,
+            bonds,
+            constraints: Vec::new(),
+            loads: Vec::new(),
+            integrator: Integrator::VelocityVerlet,
+            dt,
+            time: 0.0,
+            step: 0,
+            timing: Timing::default(),
+            exchange: Box::new(Local),
+        }
+    }
+
+    /// Forces at the current state, loads and constraint reactions included. Returns the
+    /// number of bonds that broke.
+    pub fn compute_forces(&mut self) -> usize {
+        let p = &mut self.particles;
+        let mut t = Instant::now();
+        self.exchange.forward(p);
+        t = self.timing.lap(Phase::Communication, t);
+        if <M::State as Attributes>::LEN > 0 {
+            forces::state_pass(&self.model, p, &self.bonds);
+            self.exchange.reverse_state(p);
+            forces::finish_state(&self.model, p);
+            self.exchange.forward_state(p);
+            t = self.timing.lap(Phase::State, t);
+        }
+        let broken = forces::pair_pass(&self.model, p, &mut self.bonds);
+        t = self.timing.lap(Phase::Forces, t);
+        self.exchange.reverse_force(p);
+        t = self.timing.lap(Phase::Communication, t);
+        for load in &self.loads {
+            load.apply(p, self.time);
+        }
+        for c in &mut self.constraints {
+            c.take_forces(p);
+        }
+        self.timing.lap(Phase::Boundary, t);
+        broken
+    }
+
+    /// v += h·F/m on every owned generalized DOF.
+    fn kick(&mut self, h: f64) {
+        let n = <M::Force as Attributes>::LEN;
+        let p = &mut self.particles;
+        for i in 0..p.n_owned {
+            let f = p.force[i].as_slice();
+            let inv = p.inv_inertia[i].as_slice();
+            let a = p.alter[i].as_mut_slice();
+            for k in 0..n {
+                a[n + k] += h * f[k] * inv[k];
+            }
+        }
+    }
+
+    /// q += h·v on every owned generalized DOF.
+    fn drift(&mut self, h: f64) {
+        let n = <M::Force as Attributes>::LEN;
+        let p = &mut self.particles;
+        for i in 0..p.n_owned {
+            let a = p.alter[i].as_mut_slice();
+            for k in 0..n {
+                a[k] += h * a[n + k];
+            }
+        }
+    }
+
+    /// Advances one time step; returns the number of bonds that broke in it.
+    pub fn advance(&mut self) -> usize {
+        let (dt, t0) = (self.dt, self.time);
+        let start = Instant::now();
+        match self.integrator {
+            Integrator::VelocityVerlet => self.kick(0.5 * dt),
+            Integrator::SemiImplicitEuler => self.kick(dt),
+        }
+        for c in &self.constraints {
+            c.set_drift_velocity(&mut self.particles, t0, dt);
+        }
+        self.drift(dt);
+        self.time = t0 + dt;
+        self.step += 1;
+        self.timing.lap(Phase::Integration, start);
+        let broken = self.compute_forces();
+        let start = Instant::now();
+        if self.integrator == Integrator::VelocityVerlet {
+            self.kick(0.5 * dt);
+        }
+        for c in &self.constraints {
+            c.set_velocity(&mut self.particles, self.time, dt);
+        }
+        self.timing.lap(Phase::Integration, start);
+        broken
+    }
+
+    pub fn strain_energy(&self) -> f64 {
+        forces::strain_energy(&self.model, &self.particles, &self.bonds)
+    }
+
+    pub fn kinetic_energy(&self) -> f64 {
+        self.particles.kinetic_energy()
+    }
+}
+
+/// The Silling–Askari stable time step, min over particles of √(2ρ_i / Σ_j V_j C_ij)
+/// (THEORY.md §4), and the particle that sets it. Infinite if no particle has a bond.
+pub fn stable_time_step<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &BondList<M::Bond>,
+) -> (f64, usize) {
+    let mut sum = vec![0.0; p.len()];
+    for (i, j, b) in bonds.iter() {
+        let c = model.bond_stiffness(p.material[i], p.material[j], &bonds.geom[b]);
+        sum[i] += p.volume[j] * c;
+        sum[j] += p.volume[i] * c;
+    }
+    let mut best = (f64::INFINITY, 0);
+    for i in 0..p.n_owned {
+        if sum[i] > 0.0 {
+            let rho = 1.0 / (p.inv_inertia[i].as_slice()[0] * p.volume[i]);
+            let dt = (2.0 * rho / sum[i]).sqrt();
+            if dt < best.0 {
+                best = (dt, i);
+            }
+        }
+    }
+    best
+}
