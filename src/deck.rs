@@ -691,18 +691,19 @@ impl Converter {
         let s = m.get_ref();
         let sys = self.sys;
         let ctx = format!("material '{name}'");
-        let kind =
-            match s.kind.as_deref().unwrap_or("solid") {
-                "solid" => MaterialKind::Solid,
-                "concrete" => MaterialKind::Concrete,
-                "steel" => MaterialKind::Steel,
-                other => return self.err(
+        let kind = match s.kind.as_deref().unwrap_or("solid") {
+            "solid" => MaterialKind::Solid,
+            "concrete" => MaterialKind::Concrete,
+            "steel" => MaterialKind::Steel,
+            other => {
+                return self.err(
                     line,
                     format!(
                         "{ctx}: unknown kind '{other}' (use \"solid\", \"concrete\" or \"steel\")"
                     ),
-                ),
-            };
+                )
+            }
+        };
         let density = s.density.value(sys);
         if !(density.is_finite() && density > 0.0) {
             return self.err(line, format!("{ctx}: density must be > 0 (got {density})"));
@@ -970,12 +971,14 @@ impl Converter {
                 "y" => &[1],
                 "z" => &[2],
                 "all" => &[0, 1, 2],
-                other => return self.err(
-                    line,
-                    format!(
+                other => {
+                    return self.err(
+                        line,
+                        format!(
                         "{ctx}: unknown component '{other}' (use \"x\", \"y\", \"z\" or \"all\")"
                     ),
-                ),
+                    )
+                }
             };
             for d in more {
                 if !dofs.contains(d) {

@@ -231,3 +231,17 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
 fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
     (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
 }
+
+/// Builds model `M` from the deck's materials and horizon (the deck's model name is not
+/// consulted): for tests and tools that know their model at compile time.
+pub fn build_as<M: Model>(scene: &Scene) -> Result<Setup<M>, DeckError> {
+    let b = ModelBuild {
+        materials: &scene.materials,
+        horizon: scene.horizon,
+        spacing: scene.spacing,
+        options: &scene.model_options,
+    };
+    let model =
+        M::build(&b).map_err(|e| scene.error(Some(scene.model_line), format!("[model] {e}")))?;
+    build(model, scene)
+}

@@ -1,0 +1,642 @@
+//! Malformed decks fed to the real `pdq check`: each must fail cleanly (non-zero exit,
+//! `error: <file>:<line>: <message>` on stderr, no panic) with a message that names the problem
+//! and, where the problem sits on a known line, that line.
+//!
+//! Every case is a small edit of [`BASE`], a valid 6 × 6 × 6 block that checks in milliseconds.
+//! Expected lines are found in the edited deck text, never hard-coded, so the base deck may
+//! change freely. Tests marked `#[ignore]` document known bugs in the error reporting; run
+//! them with `cargo test --test deck_errors -- --ignored`.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+/// A valid deck: 216 particles 1 mm apart, clamped at the bottom layer.
+const BASE: &str = r#"# A 6 x 6 x 6 block of particles, 1 mm apart, clamped at the bottom.
+title = "deck_errors base"
+units = "SI"
+
+[model]
+name = "pmb"
+horizon = "3.015 mm"
+
+[lattice]
+spacing = "1 mm"
+
+[materials.mortar]
+density = "2200 kg/m^3"
+youngs_modulus = "30 GPa"
+critical_stretch = 0.0005
+
+[[geometry]]
+shape = "box"
+material = "mortar"
+min = "0 0 0 mm"
+max = "6 6 6 mm"
+
+[time]
+steps = 10
+safety_factor = 0.8
+
+[[boundary]]
+name = "clamp"
+region = { shape = "slab", axis = "z", from = "0 mm", to = "1 mm" }
+fixed = ["all"]
+
+[output]
+progress = false
+"#;
+
+/// The boundary's region in [`BASE`], for cases that swap it.
+const CLAMP_REGION: &str = r#"{ shape = "slab", axis = "z", from = "0 mm", to = "1 mm" }"#;
+
+/// [`BASE`] with `from` (which must occur exactly once) replaced by `to`.
+fn edit(from: &str, to: &str) -> String {
+    edit_deck(BASE, from, to)
+}
+
+fn edit_deck(deck: &str, from: &str, to: &str) -> String {
+    let n = deck.matches(from).count();
+    assert_eq!(
+        n, 1,
+        "the deck has {n} occurrences of {from:?}, want exactly 1"
+    );
+    deck.replacen(from, to, 1)
+}
+
+/// [`BASE`] with `text` inserted just before the line `[time]`.
+fn insert_before_time(text: &str) -> String {
+    edit("[time]\n", &format!("{text}\n[time]\n"))
+}
+
+/// 1-based number of the only line of `deck` that starts with `start` (ignoring indentation).
+fn line_of(deck: &str, start: &str) -> usize {
+    let hits: Vec<usize> = lines_starting(deck, start);
+    assert_eq!(
+        hits.len(),
+        1,
+        "want exactly one line starting with {start:?}, found {hits:?}"
+    );
+    hits[0]
+}
+
+/// 1-based number of the last line of `deck` that starts with `start`.
+fn last_line_of(deck: &str, start: &str) -> usize {
+    *lines_starting(deck, start)
+        .last()
+        .unwrap_or_else(|| panic!("no line starts with {start:?}"))
+}
+
+fn lines_starting(deck: &str, start: &str) -> Vec<usize> {
+    deck.lines()
+        .enumerate()
+        .filter(|(_, l)| l.trim_start().starts_with(start))
+        .map(|(i, _)| i + 1)
+        .collect()
+}
+
+struct Outcome {
+    path: PathBuf,
+    success: bool,
+    stdout: String,
+    stderr: String,
+}
+
+/// Writes `deck` to a fresh file named after `case` and runs `pdq check` on it.
+fn check(case: &str, deck: &str) -> Outcome {
+    let dir = std::env::temp_dir().join(format!("pdq_deck_errors_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("create the temp dir");
+    let path = dir.join(format!("{case}.toml"));
+    std::fs::write(&path, deck).expect("write the deck");
+    let out = Command::new(env!("CARGO_BIN_EXE_pdq"))
+        .arg("check")
+        .arg(&path)
+        .current_dir(&dir)
+        .output()
+        .expect("run pdq");
+    Outcome {
+        path,
+        success: out.status.success(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// `pdq check` must reject `deck` cleanly, say every one of `phrases`, and, when `line` is
+/// given, locate the error at that line of the deck.
+fn assert_rejected(case: &str, deck: &str, phrases: &[&str], line: Option<usize>) {
+    let out = check(case, deck);
+    let stderr = &out.stderr;
+    let ctx = format!(
+        "case {case}, deck {}:\n{deck}\n--- stderr:\n{stderr}",
+        out.path.display()
+    );
+    assert!(!out.success, "pdq check accepted a bad deck; {ctx}");
+    assert!(!stderr.contains("panicked"), "pdq panicked; {ctx}");
+    assert!(stderr.contains("error:"), "no 'error:' on stderr; {ctx}");
+    // Phrases are looked for with the file name blanked out: it contains the case name.
+    let message = stderr.replace(&out.path.display().to_string(), "<deck>");
+    for p in phrases {
+        assert!(message.contains(p), "stderr does not mention {p:?}; {ctx}");
+    }
+    if let Some(line) = line {
+        let at = format!("{}:{line}:", out.path.display());
+        assert!(stderr.contains(&at), "error not located at {at:?}; {ctx}");
+    }
+    let _ = std::fs::remove_file(&out.path);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The base deck itself.
+
+#[test]
+fn base_deck_checks() {
+    let out = check("base", BASE);
+    assert!(
+        out.success && out.stdout.contains("particles"),
+        "the base deck must pass; stdout:\n{}\nstderr:\n{}",
+        out.stdout,
+        out.stderr
+    );
+    let particles = out.stdout.lines().find(|l| l.starts_with("particles"));
+    assert!(
+        particles.is_some_and(|l| l.contains("216")),
+        "6 x 6 x 6 particles expected:\n{}",
+        out.stdout
+    );
+    let _ = std::fs::remove_file(&out.path);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Keys the deck does not know.
+
+/// A stray top-level key (meant as a comment, or a typo of a section name).
+#[test]
+fn unknown_top_level_key() {
+    let deck = edit("units = \"SI\"\n", "units = \"SI\"\ncolour = \"red\"\n");
+    assert_rejected(
+        "top_key",
+        &deck,
+        &["colour", "unknown field"],
+        Some(line_of(&deck, "colour")),
+    );
+}
+
+/// A typo inside a table: `horizn` for `horizon`.
+#[test]
+fn unknown_key_in_model() {
+    let deck = edit("horizon = ", "horizn = ");
+    assert_rejected(
+        "model_key",
+        &deck,
+        &["horizn", "horizon"],
+        Some(line_of(&deck, "horizn")),
+    );
+}
+
+/// A misspelt material property.
+#[test]
+fn unknown_key_in_material() {
+    let deck = edit("critical_stretch", "critical_strech");
+    let line = line_of(&deck, "critical_strech");
+    assert_rejected("material_key", &deck, &["critical_strech"], Some(line));
+}
+
+/// A `[model.options]` entry the model does not have.
+#[test]
+fn unknown_model_option() {
+    let deck = edit(
+        "horizon = \"3.015 mm\"\n",
+        "horizon = \"3.015 mm\"\n\n[model.options]\nbogus = 1\n",
+    );
+    assert_rejected(
+        "model_option",
+        &deck,
+        &["bogus", "pmb"],
+        Some(line_of(&deck, "[model]")),
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Units.
+
+/// A unit PDQ does not know.
+#[test]
+fn unknown_unit() {
+    let deck = edit("\"2200 kg/m^3\"", "\"3 furlongs\"");
+    let line = line_of(&deck, "density");
+    assert_rejected(
+        "unknown_unit",
+        &deck,
+        &["furlongs", "unknown unit"],
+        Some(line),
+    );
+}
+
+/// A length where a stress belongs.
+#[test]
+fn dimension_mismatch() {
+    let deck = edit("\"30 GPa\"", "\"3 in\"");
+    let line = line_of(&deck, "youngs_modulus");
+    assert_rejected(
+        "dimension",
+        &deck,
+        &["stress", "length", "3 in"],
+        Some(line),
+    );
+}
+
+/// A unit system that does not exist.
+#[test]
+fn unknown_unit_system() {
+    let deck = edit("units = \"SI\"", "units = \"furlong-firkin-fortnight\"");
+    let line = line_of(&deck, "units");
+    assert_rejected(
+        "unit_system",
+        &deck,
+        &["furlong-firkin-fortnight", "unit system"],
+        Some(line),
+    );
+}
+
+/// A vector with two components.
+#[test]
+fn vector_with_two_numbers() {
+    let deck = edit("max = \"6 6 6 mm\"", "max = \"6 6 mm\"");
+    assert_rejected(
+        "two_numbers",
+        &deck,
+        &["three numbers", "6 6 mm"],
+        Some(line_of(&deck, "max")),
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// TOML itself.
+
+/// A missing `=`.
+#[test]
+fn bad_toml_syntax() {
+    let deck = edit("steps = 10", "steps 10");
+    assert_rejected(
+        "syntax",
+        &deck,
+        &["expected `=`"],
+        Some(line_of(&deck, "steps 10")),
+    );
+}
+
+/// The same key twice in a table.
+#[test]
+fn duplicate_toml_key() {
+    let deck = edit("steps = 10\n", "steps = 10\nsteps = 11\n");
+    assert_rejected(
+        "duplicate_key",
+        &deck,
+        &["duplicate key"],
+        Some(line_of(&deck, "steps = 11")),
+    );
+}
+
+/// The whole `[time]` table left out.
+#[test]
+fn missing_time() {
+    let deck = edit("[time]\nsteps = 10\nsafety_factor = 0.8\n", "");
+    assert_rejected("no_time", &deck, &["missing field `time`"], None);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Model, horizon and materials.
+
+/// A model name that is not registered.
+#[test]
+fn unknown_model() {
+    let deck = edit("name = \"pmb\"", "name = \"pmbb\"");
+    let line = line_of(&deck, "[model]");
+    assert_rejected(
+        "model_name",
+        &deck,
+        &["pmbb", "unknown model", "concrete"],
+        Some(line),
+    );
+}
+
+/// A negative horizon (semantic errors are located at the table that holds the key).
+#[test]
+fn negative_horizon() {
+    let deck = edit("\"3.015 mm\"", "\"-3 mm\"");
+    assert_rejected(
+        "negative_horizon",
+        &deck,
+        &["horizon", "> 0"],
+        Some(line_of(&deck, "[model]")),
+    );
+}
+
+/// A horizon smaller than the lattice spacing: no particle would have a bond.
+#[test]
+fn horizon_below_spacing() {
+    let deck = edit("\"3.015 mm\"", "\"0.5 mm\"");
+    let line = line_of(&deck, "[model]");
+    assert_rejected(
+        "small_horizon",
+        &deck,
+        &["horizon", "smaller than the lattice spacing"],
+        Some(line),
+    );
+}
+
+/// A negative density.
+#[test]
+fn negative_density() {
+    let deck = edit("\"2200 kg/m^3\"", "\"-2200 kg/m^3\"");
+    let line = line_of(&deck, "[materials.mortar]");
+    assert_rejected(
+        "negative_density",
+        &deck,
+        &["mortar", "density", "> 0"],
+        Some(line),
+    );
+}
+
+/// Poisson's ratio 0.3 with bond-based PMB, which is fixed at 1/4.
+#[test]
+fn pmb_with_poisson_ratio() {
+    let deck = edit(
+        "critical_stretch = 0.0005\n",
+        "critical_stretch = 0.0005\npoisson_ratio = 0.3\n",
+    );
+    assert_rejected(
+        "pmb_poisson",
+        &deck,
+        &["mortar", "Poisson", "0.3", "poisson_ratio"],
+        None,
+    );
+}
+
+/// As above, but the error should point at the material (or its poisson_ratio), not at `[model]`.
+#[test]
+#[ignore = "bug: model-build errors about a material are located at [model], not at the material"]
+fn pmb_with_poisson_ratio_line() {
+    let deck = edit(
+        "critical_stretch = 0.0005\n",
+        "critical_stretch = 0.0005\npoisson_ratio = 0.3\n",
+    );
+    let line = line_of(&deck, "[materials.mortar]");
+    assert_rejected("pmb_poisson_line", &deck, &["poisson_ratio"], Some(line));
+}
+
+/// The concrete model with a concrete material lacking its tensile stretch.
+fn concrete_without_tensile_stretch_deck() -> String {
+    let deck = edit("name = \"pmb\"", "name = \"concrete\"");
+    edit_deck(
+        &deck,
+        "critical_stretch = 0.0005\n",
+        "kind = \"concrete\"\npoisson_ratio = 0.25\ncompressive_stretch = -0.005\n",
+    )
+}
+
+#[test]
+fn concrete_without_tensile_stretch() {
+    let deck = concrete_without_tensile_stretch_deck();
+    assert_rejected(
+        "concrete_tensile",
+        &deck,
+        &["mortar", "tensile_stretch", "concrete"],
+        None,
+    );
+}
+
+#[test]
+#[ignore = "bug: model-build errors about a material are located at [model], not at the material"]
+fn concrete_without_tensile_stretch_line() {
+    let deck = concrete_without_tensile_stretch_deck();
+    let line = line_of(&deck, "[materials.mortar]");
+    assert_rejected(
+        "concrete_tensile_line",
+        &deck,
+        &["tensile_stretch"],
+        Some(line),
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geometry.
+
+/// No `[[geometry]]` at all: no particles.
+#[test]
+fn no_geometry() {
+    let deck = edit(
+        "[[geometry]]\nshape = \"box\"\nmaterial = \"mortar\"\nmin = \"0 0 0 mm\"\nmax = \"6 6 6 mm\"\n",
+        "",
+    );
+    assert_rejected(
+        "no_geometry",
+        &deck,
+        &["[[geometry]]", "no particles"],
+        None,
+    );
+}
+
+/// A box between lattice sites (sites sit at 0.5 mm, 1.5 mm, ...).
+#[test]
+fn geometry_box_selects_no_site() {
+    let deck = edit(
+        "min = \"0 0 0 mm\"\nmax = \"6 6 6 mm\"",
+        "min = \"0.1 0.1 0.1 mm\"\nmax = \"0.3 0.3 0.3 mm\"",
+    );
+    let line = line_of(&deck, "[[geometry]]");
+    assert_rejected(
+        "empty_box",
+        &deck,
+        &["geometry entry 0", "selects no lattice site"],
+        Some(line),
+    );
+}
+
+/// A subtract larger than the block removes every particle.
+fn subtract_everything_deck() -> String {
+    insert_before_time("[[geometry]]\nshape = \"box\"\nop = \"subtract\"\nmin = \"-1 -1 -1 mm\"\nmax = \"7 7 7 mm\"\n")
+}
+
+#[test]
+fn subtract_removes_everything() {
+    let deck = subtract_everything_deck();
+    assert_rejected("subtract_all", &deck, &["no particles", "subtracted"], None);
+}
+
+#[test]
+#[ignore = "bug: 'the scene has no particles' has no line, though the subtract entry that emptied it is known"]
+fn subtract_removes_everything_line() {
+    let deck = subtract_everything_deck();
+    let line = last_line_of(&deck, "[[geometry]]");
+    assert_rejected("subtract_all_line", &deck, &["no particles"], Some(line));
+}
+
+/// A geometry entry naming a material that is not defined (typo).
+#[test]
+fn unknown_material_in_geometry() {
+    let deck = edit("material = \"mortar\"", "material = \"mortr\"");
+    let line = line_of(&deck, "[[geometry]]");
+    assert_rejected(
+        "material_name",
+        &deck,
+        &["mortr", "unknown material", "mortar"],
+        Some(line),
+    );
+}
+
+/// A key that belongs to another shape.
+#[test]
+fn box_given_a_radius() {
+    let deck = edit(
+        "max = \"6 6 6 mm\"",
+        "max = \"6 6 6 mm\"\nradius = \"1 mm\"",
+    );
+    let line = line_of(&deck, "[[geometry]]");
+    assert_rejected("box_radius", &deck, &["box", "radius"], Some(line));
+}
+
+/// A reinforcing bar along a zero direction vector.
+#[test]
+#[ignore = "bug: a zero bar direction is reported as 'end points must be finite ... NaN', not as a bad direction"]
+fn bar_with_zero_direction() {
+    let deck = insert_before_time(
+        "[[bar]]\nmaterial = \"mortar\"\narea = \"1 mm^2\"\nfrom = \"1 1 1 mm\"\ndirection = [0, 0, 0]\nlength = \"3 mm\"\n",
+    );
+    let line = line_of(&deck, "[[bar]]");
+    assert_rejected("bar_direction", &deck, &["direction"], Some(line));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Time.
+
+/// A time step far above the stable one, without `force_dt`.
+fn dt_too_large_deck() -> String {
+    edit("safety_factor = 0.8", "dt = \"1 s\"")
+}
+
+#[test]
+fn dt_above_stable_time_step() {
+    let deck = dt_too_large_deck();
+    assert_rejected(
+        "dt_large",
+        &deck,
+        &["dt", "stable time step", "force_dt"],
+        None,
+    );
+}
+
+#[test]
+#[ignore = "bug: the dt-above-stable error (setup.rs) carries no line, though [time] dt has one"]
+fn dt_above_stable_time_step_line() {
+    let deck = dt_too_large_deck();
+    let line = line_of(&deck, "[time]");
+    assert_rejected("dt_large_line", &deck, &["stable time step"], Some(line));
+}
+
+/// An integrator PDQ does not have.
+#[test]
+fn unknown_integrator() {
+    let deck = edit(
+        "safety_factor = 0.8",
+        "safety_factor = 0.8\nintegrator = \"leapfrog\"",
+    );
+    let line = line_of(&deck, "[time]");
+    assert_rejected(
+        "integrator",
+        &deck,
+        &["leapfrog", "integrator", "verlet"],
+        Some(line),
+    );
+}
+
+/// A time given without a number: the message should show a time example, not a stress.
+#[test]
+#[ignore = "bug: units.rs says 'expected e.g. \"25 GPa\"' for every quantity, here a time"]
+fn time_without_a_number() {
+    let deck = edit("safety_factor = 0.8", "dt = \"fast\"");
+    let out = check("dt_fast", &deck);
+    assert!(
+        !out.stderr.contains("GPa"),
+        "a time should not be exemplified by a stress:\n{}",
+        out.stderr
+    );
+    assert_rejected(
+        "dt_fast",
+        &deck,
+        &["fast", "s\""],
+        Some(line_of(&deck, "dt")),
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Boundary conditions.
+
+/// A boundary region above the block: it clamps nothing.
+#[test]
+fn boundary_region_selects_nothing() {
+    let deck = edit(
+        "from = \"0 mm\", to = \"1 mm\"",
+        "from = \"10 mm\", to = \"11 mm\"",
+    );
+    let line = line_of(&deck, "[[boundary]]");
+    assert_rejected(
+        "empty_region",
+        &deck,
+        &["clamp", "selects no particle"],
+        Some(line),
+    );
+}
+
+/// A cylinder region with a negative radius.
+#[test]
+fn cylinder_with_negative_radius() {
+    let cyl = r#"{ shape = "cylinder", base = "3 3 0 mm", axis = "z", length = "1 mm", radius = "-1 mm" }"#;
+    let deck = edit(CLAMP_REGION, cyl);
+    let line = line_of(&deck, "[[boundary]]");
+    assert_rejected(
+        "negative_radius",
+        &deck,
+        &["cylinder", "radius", "> 0"],
+        Some(line),
+    );
+}
+
+/// A boundary both fixed and moving.
+#[test]
+fn boundary_fixed_and_velocity() {
+    let deck = edit(
+        "fixed = [\"all\"]",
+        "fixed = [\"all\"]\nvelocity = \"0 0 1 m/s\"",
+    );
+    let line = line_of(&deck, "[[boundary]]");
+    assert_rejected(
+        "fixed_velocity",
+        &deck,
+        &["clamp", "fixed", "velocity", "exactly one"],
+        Some(line),
+    );
+}
+
+/// Explicit ids past the last particle (the block has ids 0..=215).
+#[test]
+fn region_with_nonexistent_id() {
+    let deck = edit(CLAMP_REGION, "{ ids = [0, 999] }");
+    let line = line_of(&deck, "[[boundary]]");
+    assert_rejected("bad_id", &deck, &["999", "does not exist"], Some(line));
+}
+
+/// Two boundaries with the same name (copy-paste).
+#[test]
+fn duplicate_boundary_name() {
+    let clamp =
+        format!("[[boundary]]\nname = \"clamp\"\nregion = {CLAMP_REGION}\nfixed = [\"all\"]\n");
+    let deck = edit(&clamp, &format!("{clamp}\n{clamp}"));
+    let line = last_line_of(&deck, "[[boundary]]");
+    assert_rejected(
+        "duplicate_name",
+        &deck,
+        &["clamp", "used twice"],
+        Some(line),
+    );
+}

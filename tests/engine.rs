@@ -1,0 +1,400 @@
+//! Engine properties that must hold for any deck: conservation, bond history, breaking rule,
+//! time-step checks, and the bond search.
+
+use pdq::deck;
+use pdq::models::concrete::Concrete;
+use pdq::models::pmb::Pmb;
+use pdq::setup::{build_as, Setup};
+
+/// A PMB block of `nx × ny × nz` particles at 1 mm spacing, horizon 3.015 mm, plus `extra` TOML.
+fn block(nx: usize, ny: usize, nz: usize, material: &str, extra: &str) -> String {
+    format!(
+        r#"units = "SI"
+[model]
+name = "pmb"
+horizon = "3.015 mm"
+[lattice]
+spacing = "1 mm"
+[materials.rock]
+density = "2200 kg/m^3"
+bulk_modulus = "14.9 GPa"
+{material}
+[[geometry]]
+shape = "box"
+material = "rock"
+min = "0 0 0 mm"
+max = "{nx} {ny} {nz} mm"
+[output]
+progress = false
+{extra}"#
+    )
+}
+
+fn setup_pmb(text: &str) -> Setup<Pmb> {
+    let scene = deck::parse(text, "test.toml", "test").expect("deck parses");
+    build_as::<Pmb>(&scene).expect("setup builds")
+}
+
+fn momentum_scale(s: &Setup<Pmb>) -> f64 {
+    let p = &s.sim.particles;
+    (0..p.n_owned)
+        .map(|i| {
+            let v = p.velocity(i);
+            p.volume[i] * 2200.0 * (v[0].abs() + v[1].abs() + v[2].abs())
+        })
+        .sum()
+}
+
+#[test]
+fn free_body_conserves_linear_momentum() {
+    // Two regions thrown at each other hard enough to break bonds: momentum must still hold.
+    let text = block(
+        10,
+        8,
+        8,
+        "critical_stretch = 0.001",
+        r#"[time]
+steps = 300
+[[initial]]
+region = { shape = "box", min = "0 0 0 mm", max = "5 8 8 mm" }
+velocity = "30 -5 2 m/s"
+[[initial]]
+region = { shape = "box", min = "5 0 0 mm", max = "10 8 8 mm" }
+velocity = "-20 4 1 m/s"
+"#,
+    );
+    let mut s = setup_pmb(&text);
+    let p0 = s.sim.particles.momentum();
+    let scale = momentum_scale(&s);
+    for _ in 0..300 {
+        s.sim.advance();
+    }
+    assert!(
+        s.sim.bonds.broken_count() > 0,
+        "the impact should break bonds"
+    );
+    let p1 = s.sim.particles.momentum();
+    for k in 0..3 {
+        assert!(
+            (p1[k] - p0[k]).abs() <= 1e-12 * scale,
+            "momentum component {k}: {} -> {} (scale {scale})",
+            p0[k],
+            p1[k]
+        );
+    }
+}
+
+#[test]
+fn elastic_vibration_conserves_energy() {
+    // A free block given a smooth stretching velocity field vibrates; no bond can break.
+    let text = block(
+        8,
+        8,
+        8,
+        "",
+        r#"[time]
+steps = 10000
+"#,
+    );
+    let mut s = setup_pmb(&text);
+    assert_eq!(s.sim.dt / s.dt_critical, 0.8, "default safety factor");
+    let n = s.sim.particles.n_owned;
+    for i in 0..n {
+        let x = s.sim.particles.x0[i];
+        let c = 0.004;
+        let v = s.sim.particles.velocity_mut(i);
+        v[0] = 2.0 * (x[0] - c);
+        v[1] = -1.0 * (x[1] - c);
+        v[2] = 0.5 * (x[2] - c) * (x[0] - c) / c;
+    }
+    s.sim.compute_forces();
+    let energy = |s: &Setup<Pmb>| s.sim.kinetic_energy() + s.sim.strain_energy();
+    let e0 = energy(&s);
+    let mut first = Vec::new();
+    let mut last = Vec::new();
+    for step in 1..=10_000 {
+        s.sim.advance();
+        if step <= 1000 {
+            first.push(energy(&s));
+        } else if step > 9000 {
+            last.push(energy(&s));
+        }
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let drift = (mean(&last) - mean(&first)).abs() / e0;
+    let min_strain = s.sim.strain_energy();
+    assert!(min_strain > 0.0);
+    assert_eq!(s.sim.bonds.broken_count(), 0);
+    eprintln!("relative energy drift over 10,000 steps: {drift:e}");
+    assert!(
+        drift < 1e-4,
+        "relative energy drift {drift:e} over 10,000 steps"
+    );
+}
+
+#[test]
+fn a_broken_bond_stays_broken_when_the_crack_closes() {
+    // Two halves pulled apart (bonds across the middle break), pushed back to where they
+    // started, then pulled apart again by less than the critical stretch: the thesis code
+    // re-formed the bonds here; PDQ must carry no force across the crack.
+    let text = block(
+        12,
+        4,
+        4,
+        "critical_stretch = 0.001",
+        r#"[time]
+steps = 300
+dt = "1e-8 s"
+[[boundary]]
+name = "left"
+region = { shape = "box", min = "0 0 0 mm", max = "6 4 4 mm" }
+displacement = "-0.05 0 0 mm"
+history = { table = [["0 s", 0], ["1e-6 s", 1], ["2e-6 s", 0], ["3e-6 s", 0.02]] }
+[[boundary]]
+name = "right"
+region = { shape = "box", min = "6 0 0 mm", max = "12 4 4 mm" }
+displacement = "0.05 0 0 mm"
+history = { table = [["0 s", 0], ["1e-6 s", 1], ["2e-6 s", 0], ["3e-6 s", 0.02]] }
+"#,
+    );
+    let mut s = setup_pmb(&text);
+    for _ in 0..100 {
+        s.sim.advance();
+    }
+    let broken_open: Vec<bool> = s.sim.bonds.broken.clone();
+    let count_open = broken_open.iter().filter(|&&b| b).count();
+    assert!(
+        count_open > 0,
+        "pulling apart must break the bonds across the middle"
+    );
+    for _ in 0..100 {
+        s.sim.advance();
+    }
+    // Closed again: every particle back at its reference position.
+    for i in 0..s.sim.particles.n_owned {
+        let u = s.sim.particles.displacement(i);
+        assert!(
+            u.iter().all(|c| c.abs() < 1e-12),
+            "particle {i} not back: {u:?}"
+        );
+    }
+    assert_eq!(
+        s.sim.bonds.broken, broken_open,
+        "closing the crack changed the broken set"
+    );
+    for _ in 0..100 {
+        s.sim.advance();
+    }
+    // Reopened by 2% of the first opening (stretch across the crack far below s0).
+    assert_eq!(s.sim.bonds.broken, broken_open);
+    let reaction = s.sim.constraints[0].reaction[0];
+    assert!(
+        reaction.abs() < 1e-12,
+        "a force {reaction} N is carried across a broken crack"
+    );
+}
+
+/// Two particles at distance 2 mm, the right one displaced to stretch `s`.
+fn pair_after_stretch(s: f64, s0: f64) -> bool {
+    let text = format!(
+        r#"units = "SI"
+[model]
+name = "pmb"
+horizon = "3.015 mm"
+partial_volume = false
+[lattice]
+spacing = "1 mm"
+[materials.rock]
+density = 2200
+bulk_modulus = 14.9e9
+critical_stretch = {s0:e}
+[[geometry]]
+shape = "box"
+material = "rock"
+min = [0, 0, 0]
+max = [0.001, 0.001, 0.001]
+[[geometry]]
+shape = "box"
+material = "rock"
+min = [0.002, 0, 0]
+max = [0.003, 0.001, 0.001]
+[time]
+steps = 1
+[output]
+progress = false
+"#
+    );
+    let mut st = setup_pmb(&text);
+    assert_eq!(st.sim.bonds.len(), 1);
+    let p = &mut st.sim.particles;
+    let right = (0..2).find(|&i| p.x0[i][0] > 0.001).unwrap();
+    p.alter[right].pos[0] = p.x0[right][0] + s * 0.002;
+    st.sim.compute_forces();
+    st.sim.bonds.broken[0]
+}
+
+#[test]
+fn bonds_break_exactly_when_stretch_exceeds_critical() {
+    let s0 = 0.0005;
+    assert!(!pair_after_stretch(s0 * (1.0 - 1e-9), s0));
+    assert!(!pair_after_stretch(0.0, s0));
+    assert!(
+        !pair_after_stretch(-0.5, s0),
+        "compression never breaks a PMB bond"
+    );
+    assert!(pair_after_stretch(s0 * (1.0 + 1e-9), s0));
+    assert!(pair_after_stretch(10.0 * s0, s0));
+}
+
+#[test]
+fn a_time_step_above_critical_is_refused() {
+    let text = block(6, 6, 6, "", "[time]\nsteps = 10\ndt = \"1e-6 s\"\n");
+    let scene = deck::parse(&text, "test.toml", "test").unwrap();
+    let err = build_as::<Pmb>(&scene).err().expect("must be refused");
+    let msg = err.to_string();
+    assert!(msg.contains("above the stable time step"), "{msg}");
+    assert!(
+        msg.contains("force_dt"),
+        "the message says how to override: {msg}"
+    );
+    // Forcing it is allowed.
+    let forced = text.replace("dt = \"1e-6 s\"", "dt = \"1e-6 s\"\nforce_dt = true");
+    let scene = deck::parse(&forced, "test.toml", "test").unwrap();
+    assert!(build_as::<Pmb>(&scene).is_ok());
+}
+
+#[test]
+fn semi_implicit_euler_runs_and_conserves_momentum() {
+    let text = block(
+        6,
+        6,
+        6,
+        "",
+        "[time]\nsteps = 200\nintegrator = \"euler\"\n[[initial]]\nregion = { shape = \"box\", min = \"0 0 0 mm\", max = \"3 6 6 mm\" }\nvelocity = \"1 0 0 m/s\"\n",
+    );
+    let mut s = setup_pmb(&text);
+    let p0 = s.sim.particles.momentum();
+    for _ in 0..200 {
+        s.sim.advance();
+    }
+    let p1 = s.sim.particles.momentum();
+    assert!((p1[0] - p0[0]).abs() < 1e-12 * p0[0].abs());
+    assert!(s.sim.strain_energy() > 0.0);
+}
+
+#[test]
+fn steel_bond_keeps_its_plastic_stretch() {
+    // One steel bond stretched past yield and released keeps a permanent set: at zero force
+    // its length is the plastic stretch, which the bond history holds.
+    let text = r#"units = "in-lbf-s"
+[model]
+name = "concrete"
+horizon = "3 in"
+partial_volume = false
+[lattice]
+spacing = "1 in"
+[materials.steel]
+kind = "steel"
+density = "490 lb/ft^3"
+youngs_modulus = "29000 ksi"
+poisson_ratio = 0.3
+yield_stretch = 0.01
+[[geometry]]
+shape = "box"
+material = "steel"
+min = [0, 0, 0]
+max = [1, 1, 1]
+[[geometry]]
+shape = "box"
+material = "steel"
+min = [2, 0, 0]
+max = [3, 1, 1]
+[time]
+steps = 1
+[output]
+progress = false
+"#;
+    let scene = deck::parse(text, "t.toml", "t").unwrap();
+    let mut st = build_as::<Concrete>(&scene).unwrap();
+    let right = (0..2).find(|&i| st.sim.particles.x0[i][0] > 1.0).unwrap();
+    let stretch_to = |st: &mut Setup<Concrete>, s: f64| {
+        st.sim.particles.alter[right].pos[0] = st.sim.particles.x0[right][0] + 2.0 * s;
+        st.sim.compute_forces();
+        st.sim.particles.force[right].force[0]
+    };
+    let f_yield = stretch_to(&mut st, 0.01).abs();
+    let f_beyond = stretch_to(&mut st, 0.03).abs();
+    assert!(
+        (f_beyond - f_yield).abs() < 1e-9 * f_yield,
+        "perfectly plastic"
+    );
+    assert!((st.sim.bonds.history[0].plastic_stretch - 0.02).abs() < 1e-12);
+    let f_back = stretch_to(&mut st, 0.02);
+    assert!(
+        f_back.abs() < 1e-9 * f_yield,
+        "unloaded to the plastic stretch: no force"
+    );
+    let f_compressed = stretch_to(&mut st, 0.015);
+    assert!(
+        f_compressed > 0.0,
+        "shorter than the set length pushes the particles apart"
+    );
+    assert!(!st.sim.bonds.broken[0]);
+}
+
+#[test]
+fn concrete_bond_breaks_in_tension_and_compression() {
+    let text = |s_t: f64| {
+        format!(
+            r#"units = "in-lbf-s"
+[model]
+name = "concrete"
+horizon = "3 in"
+[lattice]
+spacing = "1 in"
+[materials.concrete]
+kind = "concrete"
+density = "145 lb/ft^3"
+youngs_modulus = "3605 ksi"
+poisson_ratio = 0.25
+tensile_stretch = {s_t:e}
+compressive_stretch = -1.1e-3
+[[geometry]]
+shape = "box"
+material = "concrete"
+min = [0, 0, 0]
+max = [1, 1, 1]
+[[geometry]]
+shape = "box"
+material = "concrete"
+min = [2, 0, 0]
+max = [3, 1, 1]
+[time]
+steps = 1
+[output]
+progress = false
+"#
+        )
+    };
+    for (s, broken) in [
+        (1.0e-4, false),
+        (1.5e-4, true),
+        (-1.0e-3, false),
+        (-1.2e-3, true),
+    ] {
+        let scene = deck::parse(&text(1.387e-4), "t.toml", "t").unwrap();
+        let mut st = build_as::<Concrete>(&scene).unwrap();
+        let right = (0..2).find(|&i| st.sim.particles.x0[i][0] > 1.0).unwrap();
+        st.sim.particles.alter[right].pos[0] = st.sim.particles.x0[right][0] + 2.0 * s;
+        st.sim.compute_forces();
+        assert_eq!(st.sim.bonds.broken[0], broken, "stretch {s}");
+        // Back to zero stretch: the broken bond stays broken and carries nothing.
+        st.sim.particles.alter[right].pos[0] = st.sim.particles.x0[right][0];
+        st.sim.particles.alter[right].pos[1] = st.sim.particles.x0[right][1] + 0.01;
+        st.sim.compute_forces();
+        assert_eq!(st.sim.bonds.broken[0], broken);
+        if broken {
+            assert_eq!(st.sim.particles.force[right].force, [0.0; 3]);
+        }
+    }
+}
