@@ -113,7 +113,7 @@ impl Model for Concrete {
     fn build(b: &ModelBuild) -> Result<Self, String> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
         let factor = b.option("interface_factor").unwrap_or(3.0);
-        if !(factor > 0.0) {
+        if !(factor.is_finite() && factor > 0.0) {
             return Err("model option 'interface_factor' must be > 0".into());
         }
         let mut own = Vec::new();

@@ -79,7 +79,7 @@ impl Model for Pmb {
             if let Some(nu) = m.poisson_ratio {
                 if (nu - 0.25).abs() > 1e-9 {
                     return Err(format!(
-                        "material '{}': bond-based PMB has Poisson's ratio 1/4, the deck gives {nu}; use model 'lps' (state-based) for other values or remove 'poisson_ratio'",
+                        "material '{}': bond-based PMB has Poisson's ratio 1/4, the deck gives {nu}; remove 'poisson_ratio' (other values need a state-based model)",
                         m.name
                     ));
                 }
@@ -101,7 +101,7 @@ impl Model for Pmb {
                     ))
                 }
             };
-            if !(s0 > 0.0) {
+            if s0.is_nan() || s0 <= 0.0 {
                 return Err(format!(
                     "material '{}': critical stretch must be > 0",
                     m.name

@@ -306,6 +306,9 @@ pub struct Scene {
     pub model: String,
     pub model_line: usize,
     pub model_options: Vec<(String, f64)>,
+    /// Deck line of each material (same order as `materials`) and of `[time]`, for messages.
+    pub material_lines: Vec<usize>,
+    pub time_line: usize,
     pub horizon: f64,
     pub spacing: f64,
     pub partial_volume: bool,
@@ -326,6 +329,17 @@ pub struct Scene {
 
 impl Scene {
     /// An error located at `line` of this deck.
+    /// An error from building the model: located at the material it names, else at `[model]`.
+    pub fn model_error(&self, message: &str) -> DeckError {
+        let line = self
+            .materials
+            .iter()
+            .position(|m| message.contains(&format!("material '{}'", m.name)))
+            .map(|k| self.material_lines[k])
+            .unwrap_or(self.model_line);
+        self.error(Some(line), format!("[model] {message}"))
+    }
+
     pub fn error(&self, line: Option<usize>, message: impl Into<String>) -> DeckError {
         DeckError {
             file: self.file.clone(),
@@ -425,8 +439,10 @@ impl Converter {
             return self.err(self.line_of(&deck.materials), "too many materials");
         }
         let mut materials = Vec::new();
+        let mut material_lines = Vec::new();
         for (name, m) in deck.materials.get_ref() {
             materials.push(self.material(name, m)?);
+            material_lines.push(self.line_of(m));
         }
         let material_id = |name: &str, line: usize| -> R<u16> {
             match mat_names.iter().position(|n| n == name) {
@@ -542,6 +558,7 @@ impl Converter {
         let time_line = self.line_of(&deck.time);
         let t = deck.time.into_inner();
         let length = match (t.steps, t.duration) {
+            (Some(0), None) => return self.err(time_line, "[time] steps must be ≥ 1"),
             (Some(n), None) => RunLength::Steps(n),
             (None, Some(d)) => {
                 let d = d.value(sys);
@@ -662,6 +679,8 @@ impl Converter {
             model: ms.name,
             model_line,
             model_options: ms.options.into_iter().collect(),
+            material_lines,
+            time_line,
             horizon,
             spacing,
             partial_volume: ms.partial_volume.unwrap_or(true),
@@ -913,7 +932,12 @@ impl Converter {
                 spacing,
                 material,
             },
-            (None, Some(dir), false, Some(len)) => Bar::along(from, dir, len, area, spacing, material),
+            (None, Some(dir), false, Some(len)) => {
+                if dir.iter().all(|&c| c == 0.0) || dir.iter().any(|c| !c.is_finite()) {
+                    return self.err(line, format!("{ctx}: direction must be a non-zero vector (got {dir:?})"));
+                }
+                Bar::along(from, dir, len, area, spacing, material)
+            }
             (None, None, true, Some(len)) => Bar::at_angle(
                 from,
                 b.azimuth.unwrap_or(0.0),

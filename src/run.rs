@@ -143,7 +143,7 @@ fn describe<M: Model>(setup: &Setup<M>, scene: &Scene) -> String {
     let _ = writeln!(s, "particles  {n}: {}", material_counts(p, scene));
     let _ = writeln!(
         s,
-        "bonds      {nb} ({:.1} per particle, stored once), horizon {} = {:.3} x spacing {}",
+        "bonds      {nb}, each stored once ({:.1} per particle counting both ends), horizon {} = {:.3} x spacing {}",
         2.0 * nb as f64 / n.max(1) as f64,
         scene.horizon,
         scene.horizon / scene.spacing,

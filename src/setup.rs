@@ -32,8 +32,7 @@ pub fn with_model<V: ModelVisitor>(scene: &Scene, visitor: V) -> Result<V::Outpu
         spacing: scene.spacing,
         options: &scene.model_options,
     };
-    crate::models::visit(&scene.model, &build, visitor)
-        .map_err(|e| scene.error(Some(scene.model_line), format!("[model] {e}")))
+    crate::models::visit(&scene.model, &build, visitor).map_err(|e| scene.model_error(&e))
 }
 
 /// Store indices of the particles of a region, in store order.
@@ -72,10 +71,21 @@ fn select<M: Model>(
 pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     let start = Instant::now();
     let cloud = geometry::build(&scene.lattice, &scene.ops, &scene.bars).map_err(|e| {
+        // An empty scene is blamed on the last subtraction, the usual culprit.
+        let last_subtract = (e.message.contains("no particles"))
+            .then(|| {
+                scene
+                    .ops
+                    .iter()
+                    .rposition(|o| matches!(o, geometry::Op::Subtract { .. }))
+                    .map(|k| scene.op_lines[k])
+            })
+            .flatten();
         let line = e
             .entry
             .map(|k| scene.op_lines[k])
-            .or(e.bar.map(|k| scene.bar_lines[k]));
+            .or(e.bar.map(|k| scene.bar_lines[k]))
+            .or(last_subtract);
         scene.error(line, e.message.clone())
     })?;
 
@@ -111,7 +121,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         Some(dt) => {
             if dt > dt_critical && !scene.time.force_dt {
                 return Err(scene.error(
-                    None,
+                    Some(scene.time_line),
                     format!(
                         "[time] dt = {dt:.4e} is above the stable time step {dt_critical:.4e} (Silling–Askari bound, set by particle {} at {:?}); lower dt, use safety_factor, or set force_dt = true to run anyway",
                         particles.gid[dt_critical_particle], particles.x0[dt_critical_particle]
@@ -126,6 +136,12 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         RunLength::Steps(n) => n,
         RunLength::Duration(d) => (d / dt).ceil() as u64,
     };
+    if steps > 1_000_000_000_000 {
+        return Err(scene.error(
+            Some(scene.time_line),
+            format!("[time] the run would take {steps} steps of {dt:.4e}: shorten the duration"),
+        ));
+    }
 
     // Initial velocities.
     let nf = <M::Force as Attributes>::LEN;
@@ -241,7 +257,6 @@ pub fn build_as<M: Model>(scene: &Scene) -> Result<Setup<M>, DeckError> {
         spacing: scene.spacing,
         options: &scene.model_options,
     };
-    let model =
-        M::build(&b).map_err(|e| scene.error(Some(scene.model_line), format!("[model] {e}")))?;
+    let model = M::build(&b).map_err(|e| scene.model_error(&e))?;
     build(model, scene)
 }

@@ -185,10 +185,10 @@ pub fn stable_time_step<M: Model>(
         sum[j] += p.volume[i] * c;
     }
     let mut best = (f64::INFINITY, 0);
-    for i in 0..p.n_owned {
-        if sum[i] > 0.0 {
+    for (i, &s) in sum.iter().enumerate().take(p.n_owned) {
+        if s > 0.0 {
             let rho = 1.0 / (p.inv_inertia[i].as_slice()[0] * p.volume[i]);
-            let dt = (2.0 * rho / sum[i]).sqrt();
+            let dt = (2.0 * rho / s).sqrt();
             if dt < best.0 {
                 best = (dt, i);
             }

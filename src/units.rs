@@ -222,7 +222,7 @@ pub fn parse_quantity(text: &str) -> Result<(f64, Dim), String> {
 /// (number, SI size of its unit, dimension), kept apart so [`Quantity`] can
 /// convert without a round trip through SI.
 fn parse_parts(text: &str) -> Result<(f64, f64, Dim), String> {
-    let ex = "expected e.g. \"25 GPa\"";
+    let ex = "expected a number followed by a unit";
     let (num, rest) = split_number(text.trim())
         .ok_or_else(|| format!("\"{text}\" does not start with a number; {ex}"))?;
     if rest.trim().is_empty() {
@@ -344,7 +344,13 @@ impl<const M: i8, const L: i8, const T: i8> FromStr for Quantity<M, L, T> {
         if let Ok(v) = s.trim().parse::<f64>() {
             return Ok(Self::plain(v));
         }
-        let (v, factor, dim) = parse_parts(s)?;
+        let (v, factor, dim) = parse_parts(s).map_err(|e| {
+            if e.contains("expected a number followed by a unit") {
+                format!("{e}, e.g. \"{}\"", Self::DIM.example())
+            } else {
+                e
+            }
+        })?;
         if dim != Self::DIM {
             return Err(mismatch(Self::DIM, s, dim));
         }

@@ -104,7 +104,7 @@ steps = 10000
         let c = 0.004;
         let v = s.sim.particles.velocity_mut(i);
         v[0] = 2.0 * (x[0] - c);
-        v[1] = -1.0 * (x[1] - c);
+        v[1] = -(x[1] - c);
         v[2] = 0.5 * (x[2] - c) * (x[0] - c) / c;
     }
     s.sim.compute_forces();
