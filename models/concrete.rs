@@ -52,29 +52,35 @@ pub struct Concrete {
 impl Concrete {
     #[inline(always)]
     fn law(&self, a: u16, b: u16) -> Law {
-        self.laws[a as usize * self.n + b as usize]
+        if self.n == 1 {
+            self.laws[0]
+        } else {
+            self.laws[a as usize * self.n + b as usize]
+        }
     }
 
     pub fn law_of(&self, a: u16, b: u16) -> Law {
         self.law(a, b)
     }
 
-    /// Force coefficient (before volumes and β) and whether the bond survives.
+    /// c × elastic elongation of a bond of elongation `e = r − L` and length `l`, or `None`
+    /// if it breaks now. Working with e (not s = e/L) saves a division on concrete bonds.
     #[inline(always)]
-    fn coefficient(law: Law, s: f64, plastic: &mut f64) -> Option<f64> {
+    fn coefficient(law: Law, e: f64, l: f64, plastic: &mut f64) -> Option<f64> {
         match law {
             Law::Brittle {
                 c,
                 tensile,
                 compressive,
             } => {
-                if s > tensile || s < compressive {
+                if e > tensile * l || e < compressive * l {
                     None
                 } else {
-                    Some(c * s)
+                    Some(c * e)
                 }
             }
             Law::Plastic { c, yield_, failure } => {
+                let s = e / l;
                 if s.abs() > failure {
                     return None;
                 }
@@ -84,7 +90,7 @@ impl Concrete {
                 } else if elastic < -yield_ {
                     *plastic = s + yield_;
                 }
-                Some(c * (s - *plastic))
+                Some(c * (s - *plastic) * l)
             }
         }
     }
@@ -199,13 +205,17 @@ impl Model for Concrete {
         geom: &BondGeom,
         bond: &mut PlasticStretch,
     ) -> Option<(Force3, Force3)> {
-        let (s, y, r) = stretch(i, j, geom);
-        let c = Self::coefficient(
+        let (a, b) = (i.pos(), j.pos());
+        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+        let l = geom.length;
+        let ce = Self::coefficient(
             self.law(i.material, j.material),
-            s,
+            r - l,
+            l,
             &mut bond.plastic_stretch,
         )?;
-        let f = c * geom.beta * i.volume * j.volume / r;
+        let f = ce * geom.beta * i.volume * j.volume / (l * r);
         let fi = [f * y[0], f * y[1], f * y[2]];
         Some((
             Force3 { force: fi },

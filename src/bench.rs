@@ -99,15 +99,27 @@ pub fn run(opts: &BenchOptions) -> Result<String, String> {
     let scene = deck::parse(&text, "<bench>", "bench").map_err(|e| e.to_string())?;
     struct Visit<'a>(&'a deck::Scene, &'a BenchOptions);
     impl ModelVisitor for Visit<'_> {
-        type Output = Result<String, String>;
+        type Output = Result<(String, f64), String>;
         fn visit<M: Model>(self, model: M) -> Self::Output {
             let setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
             bench_setup(setup, self.1)
         }
     }
-    let mut out = setup::with_model(&scene, Visit(&scene, opts)).map_err(|e| e.to_string())??;
+    let (mut out, ours) =
+        setup::with_model(&scene, Visit(&scene, opts)).map_err(|e| e.to_string())??;
     if opts.peer {
-        out.push_str(&peer(opts)?);
+        match peer(opts)? {
+            Ok((line, theirs)) => {
+                out.push_str(&line);
+                let _ = writeln!(
+                    out,
+                    "bench ratio lammps/pdq={:.2} (model={} vs peri/pmb, 1 core each)",
+                    theirs / ours,
+                    opts.model
+                );
+            }
+            Err(skipped) => out.push_str(&skipped),
+        }
     }
     Ok(out)
 }
@@ -115,7 +127,7 @@ pub fn run(opts: &BenchOptions) -> Result<String, String> {
 fn bench_setup<M: Model>(
     mut setup: setup::Setup<M>,
     opts: &BenchOptions,
-) -> Result<String, String> {
+) -> Result<(String, f64), String> {
     let sim = &mut setup.sim;
     let n = sim.particles.n_owned;
     let bonds = sim.bonds.len();
@@ -125,6 +137,7 @@ fn bench_setup<M: Model>(
     }
     let secs = t.elapsed().as_secs_f64();
     let ps = (n as u64 * opts.steps) as f64;
+    let us = 1e6 * secs / ps;
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -132,7 +145,7 @@ fn bench_setup<M: Model>(
         M::NAME,
         opts.steps,
         opts.threads,
-        1e6 * secs / ps,
+        us,
         1e9 * secs / (bonds as f64 * opts.steps as f64),
         sim.bonds.broken_count(),
         secs
@@ -187,7 +200,7 @@ fn bench_setup<M: Model>(
             opts.repeat.max(1)
         );
     }
-    Ok(out)
+    Ok((out, us))
 }
 
 /// The PMB force pass written by hand for this one model: the yardstick of the generic path.
@@ -238,8 +251,10 @@ pub fn hand_pmb_pass(
     force
 }
 
-/// LAMMPS `peri/pmb` on the same scene, if `lmp` is on the PATH.
-fn peer(opts: &BenchOptions) -> Result<String, String> {
+/// LAMMPS `peri/pmb` on the same scene: `Ok(Ok((line, µs per particle-step)))`, or
+/// `Ok(Err(line))` saying why it was skipped (no `lmp` on the PATH).
+#[allow(clippy::type_complexity)]
+fn peer(opts: &BenchOptions) -> Result<Result<(String, f64), String>, String> {
     let lmp = std::env::var("PDQ_LMP").unwrap_or_else(|_| "lmp".into());
     let dir = std::env::temp_dir().join(format!("pdq-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
@@ -257,9 +272,9 @@ fn peer(opts: &BenchOptions) -> Result<String, String> {
     let output = match output {
         Ok(o) => o,
         Err(e) => {
-            return Ok(format!(
+            return Ok(Err(format!(
                 "bench peer=lammps-peri/pmb skipped: cannot run '{lmp}' ({e}); install it with apt-get install lammps\n"
-            ))
+            )))
         }
     };
     let text = String::from_utf8_lossy(&output.stdout);
@@ -281,8 +296,11 @@ fn peer(opts: &BenchOptions) -> Result<String, String> {
         .get(8)
         .and_then(|s| s.parse().ok())
         .ok_or("bad Loop time line")?;
-    Ok(format!(
-        "bench peer=lammps-peri/pmb particles={atoms} steps={steps} threads=1 ranks=1 us_per_particle_step={:.4}\n",
-        1e6 * secs / (atoms * steps)
-    ))
+    let us = 1e6 * secs / (atoms * steps);
+    Ok(Ok((
+        format!(
+            "bench peer=lammps-peri/pmb particles={atoms} steps={steps} threads=1 ranks=1 us_per_particle_step={us:.4}\n"
+        ),
+        us,
+    )))
 }
