@@ -124,6 +124,21 @@ impl Model for Concrete {
         }
         let mut own = Vec::new();
         for m in b.materials {
+            let used: &[&str] = match m.kind {
+                MaterialKind::Steel => &[
+                    "youngs_modulus",
+                    "poisson_ratio",
+                    "yield_stretch",
+                    "failure_stretch",
+                ],
+                _ => &[
+                    "youngs_modulus",
+                    "poisson_ratio",
+                    "tensile_stretch",
+                    "compressive_stretch",
+                ],
+            };
+            m.only_uses(used, Self::NAME)?;
             let e = m.require(m.youngs_modulus, "youngs_modulus", Self::NAME)?;
             let nu = m.require(m.poisson_ratio, "poisson_ratio", Self::NAME)?;
             if !(nu > -1.0 && nu < 0.5) {

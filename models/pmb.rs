@@ -64,6 +64,27 @@ impl Model for Pmb {
         let delta = b.horizon;
         let mut own = Vec::new();
         for m in b.materials {
+            m.only_uses(
+                &[
+                    "bulk_modulus",
+                    "youngs_modulus",
+                    "micromodulus",
+                    "poisson_ratio",
+                    "critical_stretch",
+                    "fracture_energy",
+                ],
+                Self::NAME,
+            )?;
+            let stiffnesses = [m.micromodulus, m.bulk_modulus, m.youngs_modulus]
+                .iter()
+                .filter(|v| v.is_some())
+                .count();
+            if stiffnesses > 1 {
+                return Err(format!(
+                    "material '{}': give one of 'bulk_modulus', 'youngs_modulus' or 'micromodulus' for model 'pmb', not several",
+                    m.name
+                ));
+            }
             let c = match (m.micromodulus, m.bulk_modulus, m.youngs_modulus) {
                 (Some(c), _, _) => c,
                 (None, Some(k), _) => 18.0 * k / (PI * delta.powi(4)),

@@ -665,6 +665,9 @@ impl Converter {
                     format!("probe name '{name}' must be letters, digits, '_' or '-'"),
                 );
             }
+            if probes.iter().any(|p: &ProbeSpec| p.name == name) {
+                return self.err(line, format!("probe name '{name}' is used twice"));
+            }
             probes.push(ProbeSpec {
                 name,
                 line,
@@ -898,7 +901,30 @@ impl Converter {
             return Ok(Region::Ids(ids.clone()));
         }
         if r.shape.as_deref() == Some("all") {
+            let extra = [
+                r.min.is_some(),
+                r.max.is_some(),
+                r.base.is_some(),
+                r.center.is_some(),
+                r.axis.is_some(),
+                r.length.is_some(),
+                r.radius.is_some(),
+                r.polygon.is_some(),
+                r.from.is_some(),
+                r.to.is_some(),
+            ];
+            if extra.iter().any(|&e| e) {
+                return self.err(line, format!("{ctx}: shape \"all\" takes no other key"));
+            }
             return Ok(Region::All);
+        }
+        if r.shape.is_none() {
+            return self.err(
+                line,
+                format!(
+                    "{ctx}: needs 'shape' (box, cylinder, sphere, prism, slab or all) or 'ids'"
+                ),
+            );
         }
         Ok(Region::Shape(self.shape(r, line, &ctx)?))
     }

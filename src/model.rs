@@ -68,6 +68,41 @@ impl Material {
         }
     }
 
+    /// Names of the optional properties the deck set.
+    pub fn given(&self) -> Vec<&'static str> {
+        [
+            ("youngs_modulus", self.youngs_modulus.is_some()),
+            ("poisson_ratio", self.poisson_ratio.is_some()),
+            ("bulk_modulus", self.bulk_modulus.is_some()),
+            ("micromodulus", self.micromodulus.is_some()),
+            ("critical_stretch", self.critical_stretch.is_some()),
+            ("fracture_energy", self.fracture_energy.is_some()),
+            ("tensile_stretch", self.tensile_stretch.is_some()),
+            ("compressive_stretch", self.compressive_stretch.is_some()),
+            ("yield_stretch", self.yield_stretch.is_some()),
+            ("failure_stretch", self.failure_stretch.is_some()),
+        ]
+        .into_iter()
+        .filter(|(_, set)| *set)
+        .map(|(k, _)| k)
+        .collect()
+    }
+
+    /// Refuses properties the model would silently ignore (`compressive_strength` is always
+    /// allowed: it feeds reference values such as f_r = 7.5√f'c, not the physics).
+    pub fn only_uses(&self, used: &[&str], model: &str) -> Result<(), String> {
+        for k in self.given() {
+            if !used.contains(&k) {
+                return Err(format!(
+                    "material '{}': model '{model}' does not use '{k}' (it reads {})",
+                    self.name,
+                    used.join(", ")
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// A property the model cannot do without.
     pub fn require(&self, value: Option<f64>, key: &str, model: &str) -> Result<f64, String> {
         value.ok_or_else(|| format!("material '{}' needs '{key}' for model '{model}'", self.name))
