@@ -45,6 +45,9 @@ impl Law {
 #[derive(Clone, Debug)]
 pub struct Concrete {
     laws: Vec<Law>,
+    /// The law when there is one material, kept in the struct (not behind the `Vec`'s
+    /// pointer) so the force loop can hold it in registers.
+    single: Law,
     n: usize,
     density: Vec<f64>,
 }
@@ -53,7 +56,7 @@ impl Concrete {
     #[inline(always)]
     fn law(&self, a: u16, b: u16) -> Law {
         if self.n == 1 {
-            self.laws[0]
+            self.single
         } else {
             self.laws[a as usize * self.n + b as usize]
         }
@@ -197,6 +200,7 @@ impl Model for Concrete {
             }
         }
         Ok(Concrete {
+            single: laws[0],
             laws,
             n,
             density: b.materials.iter().map(|m| m.density).collect(),

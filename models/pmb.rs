@@ -29,6 +29,9 @@ pub struct Law {
 pub struct Pmb {
     /// `laws[a * n + b]` for materials a, b.
     laws: Vec<Law>,
+    /// The law when there is one material, kept in the struct (not behind the `Vec`'s
+    /// pointer) so the force loop can hold it in registers.
+    single: Law,
     n: usize,
     density: Vec<f64>,
 }
@@ -37,7 +40,7 @@ impl Pmb {
     #[inline(always)]
     fn law(&self, a: u16, b: u16) -> Law {
         if self.n == 1 {
-            self.laws[0]
+            self.single
         } else {
             self.laws[a as usize * self.n + b as usize]
         }
@@ -141,6 +144,7 @@ impl Model for Pmb {
             }
         }
         Ok(Pmb {
+            single: laws[0],
             laws,
             n,
             density: b.materials.iter().map(|m| m.density).collect(),

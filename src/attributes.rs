@@ -26,7 +26,12 @@ impl<const N: usize> Component for [f64; N] {
 }
 
 /// Plain-data record whose fields are known by name at run time.
-pub trait Attributes:
+///
+/// # Safety
+/// The type must be `#[repr(C)]` and consist of `f64` fields only (scalars or arrays), so that
+/// it is exactly `LEN` contiguous, 8-byte aligned `f64`s. The [`attributes!`](crate::attributes!)
+/// macro guarantees this; implement the trait by hand only under the same rule.
+pub unsafe trait Attributes:
     bytemuck::Pod + Default + PartialEq + std::fmt::Debug + Send + Sync + 'static
 {
     /// Fields in declaration order; their lengths add up to [`Attributes::LEN`].
@@ -39,7 +44,10 @@ pub trait Attributes:
         if Self::LEN == 0 {
             return &[];
         }
-        bytemuck::cast_slice(bytemuck::bytes_of(self))
+        // SAFETY: the trait's contract makes `Self` exactly `LEN` aligned `f64`s. A raw cast
+        // (rather than bytemuck's checked one) keeps a run-time alignment test out of the
+        // force loop.
+        unsafe { std::slice::from_raw_parts(self as *const Self as *const f64, Self::LEN) }
     }
 
     #[inline(always)]
@@ -47,7 +55,8 @@ pub trait Attributes:
         if Self::LEN == 0 {
             return &mut [];
         }
-        bytemuck::cast_slice_mut(bytemuck::bytes_of_mut(self))
+        // SAFETY: as in `as_slice`.
+        unsafe { std::slice::from_raw_parts_mut(self as *mut Self as *mut f64, Self::LEN) }
     }
 
     /// Offset (in `f64`s) and length of the field called `name`.
@@ -64,7 +73,8 @@ pub trait Attributes:
 }
 
 /// `()` declares "nothing": no memory, no pass, no message.
-impl Attributes for () {
+// SAFETY: zero-sized; `LEN` is 0.
+unsafe impl Attributes for () {
     const FIELDS: &'static [Field] = &[];
     const LEN: usize = 0;
 }
@@ -99,7 +109,9 @@ macro_rules! attributes {
         #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
         $vis struct $name { $($(#[$fmeta])* $fvis $field: $ty),* }
 
-        impl $crate::attributes::Attributes for $name {
+        // SAFETY: `#[repr(C)]` and every field is `f64` or `[f64; N]` (`Component` is implemented
+        // for nothing else), so the record is `LEN` contiguous aligned `f64`s.
+        unsafe impl $crate::attributes::Attributes for $name {
             const FIELDS: &'static [$crate::attributes::Field] = &[$(
                 $crate::attributes::Field {
                     name: stringify!($field),
@@ -107,6 +119,10 @@ macro_rules! attributes {
                 }
             ),*];
         }
+        const _: () = assert!(
+            std::mem::align_of::<$name>() == 8
+                && std::mem::size_of::<$name>() == 8 * (0 $(+ <$ty as $crate::attributes::Component>::LEN)*)
+        );
     };
 }
 

@@ -85,13 +85,16 @@ pub fn pair_pass<M: Model>(
     );
     let mut newly_broken = 0;
     for i in 0..*n_owned {
+        // Local copies: the compiler cannot tell that the force stores below leave particle
+        // i's records alone, so references into the arrays would be reloaded on every bond.
+        let (x0_i, alter_i, fixed_i, state_i) = (x0[i], alter[i], fixed[i], state[i]);
         let side_i = Side::<M> {
-            x0: &x0[i],
+            x0: &x0_i,
             volume: volume[i],
             material: material[i],
-            alter: &alter[i],
-            fixed: &fixed[i],
-            state: &state[i],
+            alter: &alter_i,
+            fixed: &fixed_i,
+            state: &state_i,
         };
         let mut fi = M::Force::default();
         let range = offsets[i] as usize..offsets[i + 1] as usize;
