@@ -4,8 +4,7 @@
 //!
 //! Every case is a small edit of [`BASE`], a valid 6 × 6 × 6 block that checks in milliseconds.
 //! Expected lines are found in the edited deck text, never hard-coded, so the base deck may
-//! change freely. Tests marked `#[ignore]` document known bugs in the error reporting; run
-//! them with `cargo test --test deck_errors -- --ignored`.
+//! change freely.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -631,6 +630,56 @@ fn duplicate_boundary_name() {
         "duplicate_name",
         &deck,
         &["clamp", "used twice"],
+        Some(line),
+    );
+}
+
+/// PMB given two stiffnesses: which one counts would be a silent guess.
+#[test]
+fn pmb_with_two_stiffnesses() {
+    let deck = edit(
+        "critical_stretch = 0.0005\n",
+        "critical_stretch = 0.0005\nbulk_modulus = \"20 GPa\"\n",
+    );
+    let line = line_of(&deck, "[materials.mortar]");
+    assert_rejected(
+        "pmb_two_stiffnesses",
+        &deck,
+        &["mortar", "bulk_modulus", "youngs_modulus", "not several"],
+        Some(line),
+    );
+}
+
+/// A PMB-style critical stretch under the concrete model, which reads tensile/compressive
+/// stretches instead: the user's failure criterion would be lost.
+#[test]
+fn concrete_with_a_key_it_does_not_use() {
+    let deck = edit("name = \"pmb\"", "name = \"concrete\"");
+    let deck = edit_deck(
+        &deck,
+        "critical_stretch = 0.0005\n",
+        "kind = \"concrete\"\npoisson_ratio = 0.25\ntensile_stretch = 1e-4\ncompressive_stretch = -1e-3\ncritical_stretch = 0.0005\n",
+    );
+    let line = line_of(&deck, "[materials.mortar]");
+    assert_rejected(
+        "concrete_unused_key",
+        &deck,
+        &["mortar", "critical_stretch", "does not use"],
+        Some(line),
+    );
+}
+
+/// Two probes with one name would give two identical history columns.
+#[test]
+fn duplicate_probe_name() {
+    let deck = format!(
+        "{BASE}\n[[probe]]\nname = \"tip\"\nat = \"3 3 6 mm\"\n\n[[probe]]\nname = \"tip\"\nat = \"3 3 0 mm\"\n"
+    );
+    let line = last_line_of(&deck, "name = \"tip\"") - 1;
+    assert_rejected(
+        "duplicate_probe",
+        &deck,
+        &["probe", "tip", "twice"],
         Some(line),
     );
 }
