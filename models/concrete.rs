@@ -45,27 +45,11 @@ impl Law {
 #[derive(Clone, Debug)]
 pub struct Concrete {
     laws: Vec<Law>,
-    /// The law when there is one material, kept in the struct (not behind the `Vec`'s
-    /// pointer) so the force loop can hold it in registers.
-    single: Law,
     n: usize,
     density: Vec<f64>,
 }
 
 impl Concrete {
-    #[inline(always)]
-    fn law(&self, a: u16, b: u16) -> Law {
-        if self.n == 1 {
-            self.single
-        } else {
-            self.laws[a as usize * self.n + b as usize]
-        }
-    }
-
-    pub fn law_of(&self, a: u16, b: u16) -> Law {
-        self.law(a, b)
-    }
-
     /// c × elastic elongation of a bond of elongation `e = r − L` and length `l`, or `None`
     /// if it breaks now. Working with e (not s = e/L) saves a division on concrete bonds.
     #[inline(always)]
@@ -118,6 +102,7 @@ impl Model for Concrete {
     type Bond = PlasticStretch;
     type State = ();
     type Force = Force3;
+    type Law = Law;
 
     fn build(b: &ModelBuild) -> Result<Self, String> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
@@ -200,7 +185,6 @@ impl Model for Concrete {
             }
         }
         Ok(Concrete {
-            single: laws[0],
             laws,
             n,
             density: b.materials.iter().map(|m| m.density).collect(),
@@ -212,13 +196,18 @@ impl Model for Concrete {
         Force3 { force: [m; 3] }
     }
 
-    fn bond_stiffness(&self, mi: u16, mj: u16, geom: &BondGeom) -> f64 {
-        self.law(mi, mj).stiffness() / geom.length
+    fn law(&self, mi: u16, mj: u16) -> Law {
+        self.laws[mi as usize * self.n + mj as usize]
+    }
+
+    fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> f64 {
+        law.stiffness() / geom.length
     }
 
     #[inline(always)]
     fn pair(
         &self,
+        law: &Law,
         i: &Side<Self>,
         j: &Side<Self>,
         geom: &BondGeom,
@@ -228,12 +217,7 @@ impl Model for Concrete {
         let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
         let l = geom.length;
-        let ce = Self::coefficient(
-            self.law(i.material, j.material),
-            r - l,
-            l,
-            &mut bond.plastic_stretch,
-        )?;
+        let ce = Self::coefficient(*law, r - l, l, &mut bond.plastic_stretch)?;
         let f = ce * geom.beta * i.volume * j.volume / (l * r);
         let fi = [f * y[0], f * y[1], f * y[2]];
         Some((
@@ -246,6 +230,7 @@ impl Model for Concrete {
 
     fn energy(
         &self,
+        law: &Law,
         i: &Side<Self>,
         j: &Side<Self>,
         geom: &BondGeom,
@@ -253,7 +238,7 @@ impl Model for Concrete {
     ) -> f64 {
         let (s, _, _) = stretch(i, j, geom);
         let elastic = s - bond.plastic_stretch;
-        let c = self.law(i.material, j.material).stiffness();
+        let c = law.stiffness();
         0.5 * c * elastic * elastic * geom.length * geom.beta * i.volume * j.volume
     }
 }

@@ -29,23 +29,11 @@ pub struct Law {
 pub struct Pmb {
     /// `laws[a * n + b]` for materials a, b.
     laws: Vec<Law>,
-    /// The law when there is one material, kept in the struct (not behind the `Vec`'s
-    /// pointer) so the force loop can hold it in registers.
-    single: Law,
     n: usize,
     density: Vec<f64>,
 }
 
 impl Pmb {
-    #[inline(always)]
-    fn law(&self, a: u16, b: u16) -> Law {
-        if self.n == 1 {
-            self.single
-        } else {
-            self.laws[a as usize * self.n + b as usize]
-        }
-    }
-
     pub fn laws(&self) -> &[Law] {
         &self.laws
     }
@@ -61,6 +49,7 @@ impl Model for Pmb {
     type Bond = ();
     type State = ();
     type Force = Force3;
+    type Law = Law;
 
     fn build(b: &ModelBuild) -> Result<Self, String> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
@@ -144,7 +133,6 @@ impl Model for Pmb {
             }
         }
         Ok(Pmb {
-            single: laws[0],
             laws,
             n,
             density: b.materials.iter().map(|m| m.density).collect(),
@@ -156,19 +144,23 @@ impl Model for Pmb {
         Force3 { force: [m; 3] }
     }
 
-    fn bond_stiffness(&self, mi: u16, mj: u16, geom: &BondGeom) -> f64 {
-        self.law(mi, mj).c / geom.length
+    fn law(&self, mi: u16, mj: u16) -> Law {
+        self.laws[mi as usize * self.n + mj as usize]
+    }
+
+    fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> f64 {
+        law.c / geom.length
     }
 
     #[inline(always)]
     fn pair(
         &self,
+        law: &Law,
         i: &Side<Self>,
         j: &Side<Self>,
         geom: &BondGeom,
         _bond: &mut (),
     ) -> Option<(Force3, Force3)> {
-        let law = self.law(i.material, j.material);
         let (a, b) = (i.pos(), j.pos());
         let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
@@ -187,8 +179,7 @@ impl Model for Pmb {
         ))
     }
 
-    fn energy(&self, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _bond: &()) -> f64 {
-        let law = self.law(i.material, j.material);
+    fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {
         let (s, _, _) = stretch(i, j, geom);
         0.5 * law.c * s * s * geom.length * geom.beta * i.volume * j.volume
     }

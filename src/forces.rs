@@ -25,7 +25,14 @@ pub fn state_pass<M: Model>(model: &M, p: &mut Particles<M>, bonds: &BondList<M:
                 continue;
             }
             let j = bonds.partners()[b] as usize;
-            let (si, sj) = model.state(&p.side(i), &p.side(j), &bonds.geom[b], &bonds.history[b]);
+            let law = model.law(p.material[i], p.material[j]);
+            let (si, sj) = model.state(
+                &law,
+                &p.side(i),
+                &p.side(j),
+                &bonds.geom[b],
+                &bonds.history[b],
+            );
             add_assign(&mut sum[i], &si);
             add_assign(&mut sum[j], &sj);
         }
@@ -49,6 +56,29 @@ pub fn pair_pass<M: Model>(
     model: &M,
     p: &mut Particles<M>,
     bonds: &mut BondList<M::Bond>,
+) -> usize {
+    // A scene of one material gets a loop with its law fixed: no material loads, no dispatch.
+    match single_material(&p.material) {
+        Some(m) => {
+            let law = model.law(m, m);
+            pair_loop(model, p, bonds, |_, _| law)
+        }
+        None => pair_loop(model, p, bonds, |a, b| model.law(a, b)),
+    }
+}
+
+/// The material of every particle, if there is only one.
+fn single_material(material: &[u16]) -> Option<u16> {
+    let first = *material.first()?;
+    material.iter().all(|&m| m == first).then_some(first)
+}
+
+#[inline(always)]
+fn pair_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
+    model: &M,
+    p: &mut Particles<M>,
+    bonds: &mut BondList<M::Bond>,
+    law_of: L,
 ) -> usize {
     let Particles {
         n_owned,
@@ -122,7 +152,8 @@ pub fn pair_pass<M: Model>(
                     force.get_unchecked_mut(j),
                 )
             };
-            match model.pair(&side_i, &side_j, &geom[k], &mut history[k]) {
+            let law = law_of(side_i.material, side_j.material);
+            match model.pair(&law, &side_i, &side_j, &geom[k], &mut history[k]) {
                 Some((a, b)) => {
                     add_assign(&mut fi, &a);
                     add_assign(fj, &b);
@@ -143,7 +174,14 @@ pub fn strain_energy<M: Model>(model: &M, p: &Particles<M>, bonds: &BondList<M::
     let mut e = 0.0;
     for (i, j, b) in bonds.iter() {
         if !bonds.broken[b] {
-            e += model.energy(&p.side(i), &p.side(j), &bonds.geom[b], &bonds.history[b]);
+            let law = model.law(p.material[i], p.material[j]);
+            e += model.energy(
+                &law,
+                &p.side(i),
+                &p.side(j),
+                &bonds.geom[b],
+                &bonds.history[b],
+            );
         }
     }
     e

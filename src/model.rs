@@ -202,6 +202,10 @@ pub trait Model: Sized + Send + Sync + 'static {
     type State: Attributes;
     /// One generalized force per integrated degree of freedom.
     type Force: Attributes;
+    /// What a bond between two materials needs (micromodulus, critical stretches …). The
+    /// engine looks it up with [`Model::law`] and hands it to every bond call; in a scene of
+    /// one material it looks it up once per pass, so the bond loop carries no material dispatch.
+    type Law: Copy + Send + Sync + 'static;
 
     fn build(b: &ModelBuild) -> Result<Self, String>;
 
@@ -213,12 +217,16 @@ pub trait Model: Sized + Send + Sync + 'static {
     /// Mass (or inertia) of each generalized degree of freedom.
     fn inertia(&self, material: u16, volume: f64, fixed: &Self::Fixed) -> Self::Force;
 
+    /// The law of a bond between materials `mi` and `mj`.
+    fn law(&self, mi: u16, mj: u16) -> Self::Law;
+
     /// Stiffness C_ij = c/|ξ| of a bond for the Silling–Askari stable time step (THEORY.md §4).
-    fn bond_stiffness(&self, mi: u16, mj: u16, geom: &BondGeom) -> f64;
+    fn bond_stiffness(&self, law: &Self::Law, geom: &BondGeom) -> f64;
 
     /// Contribution of an intact bond to both ends' state (only called if `State` is not `()`).
     fn state(
         &self,
+        _law: &Self::Law,
         _i: &Side<Self>,
         _j: &Side<Self>,
         _geom: &BondGeom,
@@ -234,6 +242,7 @@ pub trait Model: Sized + Send + Sync + 'static {
     /// `None` means the bond breaks now: the engine marks it and never calls it again.
     fn pair(
         &self,
+        law: &Self::Law,
         i: &Side<Self>,
         j: &Side<Self>,
         geom: &BondGeom,
@@ -241,7 +250,14 @@ pub trait Model: Sized + Send + Sync + 'static {
     ) -> Option<(Self::Force, Self::Force)>;
 
     /// Elastic energy stored in an intact bond (whole bond, both volumes included).
-    fn energy(&self, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, bond: &Self::Bond) -> f64;
+    fn energy(
+        &self,
+        law: &Self::Law,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+        bond: &Self::Bond,
+    ) -> f64;
 }
 
 /// Bond stretch and the current bond vector: shared by every bond-based law.

@@ -180,7 +180,8 @@ pub fn stable_time_step<M: Model>(
 ) -> (f64, usize) {
     let mut sum = vec![0.0; p.len()];
     for (i, j, b) in bonds.iter() {
-        let c = model.bond_stiffness(p.material[i], p.material[j], &bonds.geom[b]);
+        let law = model.law(p.material[i], p.material[j]);
+        let c = model.bond_stiffness(&law, &bonds.geom[b]);
         sum[i] += p.volume[j] * c;
         sum[j] += p.volume[i] * c;
     }
