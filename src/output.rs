@@ -37,7 +37,9 @@ impl History {
             first = false;
             write!(self.out, "{v:.10e}")?;
         }
-        self.out.write_all(b"\n")
+        self.out.write_all(b"\n")?;
+        // Each row reaches the file at once: a run that is killed keeps its history.
+        self.out.flush()
     }
 
     pub fn flush(&mut self) -> std::io::Result<()> {
