@@ -194,6 +194,31 @@ history = { table = [["0 s", 0], ["1e-6 s", 1], ["2e-6 s", 0], ["3e-6 s", 0.02]]
     );
 }
 
+/// `head` (units, model, lattice, materials) plus two particles of `material`, cubes of side
+/// `h` two spacings apart: a scene of exactly one bond.
+fn two_particles(head: &str, material: &str, h: f64) -> String {
+    format!(
+        r#"{head}
+[[geometry]]
+shape = "box"
+material = "{material}"
+min = [0, 0, 0]
+max = [{h:e}, {h:e}, {h:e}]
+[[geometry]]
+shape = "box"
+material = "{material}"
+min = [{h2:e}, 0, 0]
+max = [{h3:e}, {h:e}, {h:e}]
+[time]
+steps = 1
+[output]
+progress = false
+"#,
+        h2 = 2.0 * h,
+        h3 = 3.0 * h
+    )
+}
+
 /// Two particles at distance 2 mm, the right one displaced to stretch `s`.
 fn pair_after_stretch(s: f64, s0: f64) -> bool {
     let text = format!(
@@ -208,22 +233,9 @@ spacing = "1 mm"
 density = 2200
 bulk_modulus = 14.9e9
 critical_stretch = {s0:e}
-[[geometry]]
-shape = "box"
-material = "rock"
-min = [0, 0, 0]
-max = [0.001, 0.001, 0.001]
-[[geometry]]
-shape = "box"
-material = "rock"
-min = [0.002, 0, 0]
-max = [0.003, 0.001, 0.001]
-[time]
-steps = 1
-[output]
-progress = false
 "#
     );
+    let text = two_particles(&text, "rock", 0.001);
     let mut st = setup_pmb(&text);
     assert_eq!(st.sim.bonds.len(), 1);
     let p = &mut st.sim.particles;
@@ -299,22 +311,9 @@ density = "490 lb/ft^3"
 youngs_modulus = "29000 ksi"
 poisson_ratio = 0.3
 yield_stretch = 0.01
-[[geometry]]
-shape = "box"
-material = "steel"
-min = [0, 0, 0]
-max = [1, 1, 1]
-[[geometry]]
-shape = "box"
-material = "steel"
-min = [2, 0, 0]
-max = [3, 1, 1]
-[time]
-steps = 1
-[output]
-progress = false
 "#;
-    let scene = deck::parse(text, "t.toml", "t").unwrap();
+    let text = two_particles(text, "steel", 1.0);
+    let scene = deck::parse(&text, "t.toml", "t").unwrap();
     let mut st = build_as::<Concrete>(&scene).unwrap();
     let right = (0..2).find(|&i| st.sim.particles.x0[i][0] > 1.0).unwrap();
     let stretch_to = |st: &mut Setup<Concrete>, s: f64| {
@@ -359,20 +358,6 @@ youngs_modulus = "3605 ksi"
 poisson_ratio = 0.25
 tensile_stretch = {s_t:e}
 compressive_stretch = -1.1e-3
-[[geometry]]
-shape = "box"
-material = "concrete"
-min = [0, 0, 0]
-max = [1, 1, 1]
-[[geometry]]
-shape = "box"
-material = "concrete"
-min = [2, 0, 0]
-max = [3, 1, 1]
-[time]
-steps = 1
-[output]
-progress = false
 "#
         )
     };
@@ -382,7 +367,8 @@ progress = false
         (-1.0e-3, false),
         (-1.2e-3, true),
     ] {
-        let scene = deck::parse(&text(1.387e-4), "t.toml", "t").unwrap();
+        let deck_text = two_particles(&text(1.387e-4), "concrete", 1.0);
+        let scene = deck::parse(&deck_text, "t.toml", "t").unwrap();
         let mut st = build_as::<Concrete>(&scene).unwrap();
         let right = (0..2).find(|&i| st.sim.particles.x0[i][0] > 1.0).unwrap();
         st.sim.particles.alter[right].pos[0] = st.sim.particles.x0[right][0] + 2.0 * s;
