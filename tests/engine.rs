@@ -97,7 +97,10 @@ steps = 10000
 "#,
     );
     let mut s = setup_pmb(&text);
-    assert_eq!(s.sim.dt / s.dt_critical, 0.8, "default safety factor");
+    assert!(
+        (s.sim.dt / s.dt_critical - 0.8).abs() < 1e-12,
+        "default safety factor"
+    );
     let n = s.sim.particles.n_owned;
     for i in 0..n {
         let x = s.sim.particles.x0[i];
