@@ -14,8 +14,14 @@ pub struct Field {
     pub len: usize,
 }
 
-/// A field type allowed in an attribute record: `f64` or `[f64; N]`.
-pub trait Component {
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f64 {}
+    impl<const N: usize> Sealed for [f64; N] {}
+}
+
+/// A field type allowed in an attribute record: `f64` or `[f64; N]`, nothing else (sealed).
+pub trait Component: sealed::Sealed {
     const LEN: usize;
 }
 impl Component for f64 {
@@ -30,7 +36,8 @@ impl<const N: usize> Component for [f64; N] {
 /// # Safety
 /// The type must be `#[repr(C)]` and consist of `f64` fields only (scalars or arrays), so that
 /// it is exactly `LEN` contiguous, 8-byte aligned `f64`s. The [`attributes!`](crate::attributes!)
-/// macro guarantees this; implement the trait by hand only under the same rule.
+/// macro guarantees this (and checks size and alignment at compile time); implement the trait
+/// by hand only under the same rule, and never override `LEN`.
 pub unsafe trait Attributes:
     bytemuck::Pod + Default + PartialEq + std::fmt::Debug + Send + Sync + 'static
 {
@@ -109,8 +116,9 @@ macro_rules! attributes {
         #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
         $vis struct $name { $($(#[$fmeta])* $fvis $field: $ty),* }
 
-        // SAFETY: `#[repr(C)]` and every field is `f64` or `[f64; N]` (`Component` is implemented
-        // for nothing else), so the record is `LEN` contiguous aligned `f64`s.
+        // SAFETY: `#[repr(C)]`, every field is `f64` or `[f64; N]` (`Component` is sealed to
+        // those), and the assertion below checks size and alignment at compile time, so the
+        // record is `LEN` contiguous aligned `f64`s.
         unsafe impl $crate::attributes::Attributes for $name {
             const FIELDS: &'static [$crate::attributes::Field] = &[$(
                 $crate::attributes::Field {

@@ -50,7 +50,9 @@ impl<H: Attributes> BondList<H> {
         );
         let grid = CellGrid::covering(x0, horizon);
         let (cell_of, start, order) = grid.bin(x0);
-        let h2 = horizon * horizon;
+        // A pair at exactly the horizon (m = 3 on a lattice) is in the family whatever the
+        // rounding of its coordinates: the test allows a relative 1e-10.
+        let h2 = horizon * horizon * (1.0 + 2e-10);
         let mut offsets = Vec::with_capacity(n_owned + 1);
         let mut partner = Vec::new();
         let mut geom = Vec::new();

@@ -56,6 +56,9 @@ impl History {
                 if points.is_empty() {
                     return Err("history table is empty".into());
                 }
+                if points.iter().any(|p| !(p.0.is_finite() && p.1.is_finite())) {
+                    return Err("history table entries must be finite numbers".into());
+                }
                 if points.windows(2).any(|w| w[1].0 <= w[0].0) {
                     return Err("history table times must increase".into());
                 }

@@ -45,19 +45,31 @@ impl CellGrid {
             lo = [0.0; 3];
             hi = [0.0; 3];
         }
-        let mut dims = [1usize; 3];
-        let mut size = [min_size; 3];
-        for k in 0..3 {
-            let extent = hi[k] - lo[k];
-            let n = (extent / min_size).floor().max(1.0) as usize;
-            dims[k] = n;
-            // Stretch the cells so that n of them span the extent exactly; never below min_size.
-            size[k] = (extent / n as f64).max(min_size);
-        }
-        CellGrid {
-            origin: lo,
-            size,
-            dims,
+        // Cells a hair larger than asked: with a side of exactly the horizon, rounding in
+        // `coords` could put a pair at exactly the horizon two cells apart.
+        let mut target = min_size * (1.0 + 1e-9);
+        // A sparse scene (two bodies far apart, a long diagonal bar) would need more cells than
+        // memory holds; larger cells stay correct, as only size >= horizon matters.
+        let cap = (8 * points.len()).max(4096) as f64;
+        loop {
+            let mut dims = [1usize; 3];
+            let mut size = [target; 3];
+            for k in 0..3 {
+                let extent = hi[k] - lo[k];
+                let n = (extent / target).floor().clamp(1.0, 1e15) as usize;
+                dims[k] = n;
+                // n cells span the extent exactly; never below the target.
+                size[k] = (extent / n as f64).max(target);
+            }
+            let cells = dims.iter().map(|&d| d as f64).product::<f64>();
+            if cells <= cap {
+                return CellGrid {
+                    origin: lo,
+                    size,
+                    dims,
+                };
+            }
+            target *= (cells / cap).cbrt().max(1.01);
         }
     }
 
@@ -138,6 +150,14 @@ mod tests {
         all.dedup();
         assert_eq!(all.len(), 26);
         assert!(!all.contains(&[0, 0, 0]));
+    }
+
+    #[test]
+    fn sparse_scenes_get_few_large_cells() {
+        let pts = [[0.0, 0.0, 0.0], [10.0, 10.0, 10.0], [5.0, 5.0, 5.0]];
+        let g = CellGrid::covering(&pts, 0.003);
+        assert!(g.len() <= 4096, "{} cells", g.len());
+        assert!(g.size.iter().all(|&s| s >= 0.003));
     }
 
     #[test]

@@ -10,8 +10,8 @@ use crate::geometry::{Bar, Lattice, Op, Shape};
 use crate::model::{Material, MaterialKind};
 use crate::simulation::Integrator;
 use crate::units::{
-    AccelerationVector, Area, Density, EnergyPerArea, ForceDensity, ForceVector, Length,
-    Micromodulus, Position, Stress, Time, UnitSystem, Vector, VelocityVector,
+    AccelerationVector, Area, Density, EnergyPerArea, ForceVector, Length, Micromodulus, Position,
+    Stress, Time, UnitSystem, Vector, VelocityVector,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -328,7 +328,6 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// An error located at `line` of this deck.
     /// An error from building the model: located at the material it names, else at `[model]`.
     pub fn model_error(&self, message: &str) -> DeckError {
         let line = self
@@ -340,6 +339,7 @@ impl Scene {
         self.error(Some(line), format!("[model] {message}"))
     }
 
+    /// An error located at `line` of this deck.
     pub fn error(&self, line: Option<usize>, message: impl Into<String>) -> DeckError {
         DeckError {
             file: self.file.clone(),
@@ -632,7 +632,7 @@ impl Converter {
             initial.push(InitialSpec {
                 line,
                 region,
-                velocity: s.velocity.value(sys),
+                velocity: self.finite3(s.velocity.value(sys), line, "initial: velocity")?,
             });
         }
 
@@ -671,7 +671,7 @@ impl Converter {
             probes.push(ProbeSpec {
                 name,
                 line,
-                at: p.get_ref().at.value(sys),
+                at: self.finite3(p.get_ref().at.value(sys), line, "probe: 'at'")?,
             });
         }
 
@@ -770,6 +770,15 @@ impl Converter {
         }
         mat.poisson_ratio = s.poisson_ratio;
         Ok(mat)
+    }
+
+    /// A vector from the deck, refused if any component is not a finite number.
+    fn finite3(&self, v: [f64; 3], line: usize, what: &str) -> R<[f64; 3]> {
+        if v.iter().all(|c| c.is_finite()) {
+            Ok(v)
+        } else {
+            self.err(line, format!("{what} must be finite numbers (got {v:?})"))
+        }
     }
 
     fn axis_index(&self, a: &Option<AxisSpec>, line: usize, ctx: &str) -> R<usize> {
@@ -1124,6 +1133,11 @@ impl Converter {
                 format!("{ctx}: give exactly one of 'force_per_particle', 'total_force', 'body_force' or 'gravity'"),
             );
         }
+        let (LoadKind::PerParticle(v)
+        | LoadKind::Total(v)
+        | LoadKind::BodyForce(v)
+        | LoadKind::Gravity(v)) = kinds[0];
+        self.finite3(v, line, &format!("{ctx}: the load vector"))?;
         let region = match &l.region {
             Some(r) => self.region(r, line, &ctx)?,
             None => Region::All,
@@ -1143,8 +1157,3 @@ fn valid_name(n: &str) -> bool {
         && n.chars()
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
 }
-
-/// Units are checked where the deck is read; these keep a type-level reminder of the dimension
-/// body forces carry (force per volume).
-#[allow(dead_code)]
-type BodyForce = ForceDensity;

@@ -18,7 +18,9 @@ pub fn state_pass<M: Model>(model: &M, p: &mut Particles<M>, bonds: &BondList<M:
     for s in p.state.iter_mut() {
         *s = M::State::default();
     }
-    let mut sum = vec![M::State::default(); p.len()];
+    // Sums go straight into `p.state` (no buffer per step); the sides the model sees carry a
+    // zero state, since a state is not an input to its own pass.
+    let zero = M::State::default();
     for i in 0..p.n_owned {
         for b in bonds.offsets[i] as usize..bonds.offsets[i + 1] as usize {
             if bonds.broken[b] {
@@ -26,18 +28,19 @@ pub fn state_pass<M: Model>(model: &M, p: &mut Particles<M>, bonds: &BondList<M:
             }
             let j = bonds.partners()[b] as usize;
             let law = model.law(p.material[i], p.material[j]);
-            let (si, sj) = model.state(
-                &law,
-                &p.side(i),
-                &p.side(j),
-                &bonds.geom[b],
-                &bonds.history[b],
-            );
-            add_assign(&mut sum[i], &si);
-            add_assign(&mut sum[j], &sj);
+            let side = |k: usize| Side::<M> {
+                x0: &p.x0[k],
+                volume: p.volume[k],
+                material: p.material[k],
+                alter: &p.alter[k],
+                fixed: &p.fixed[k],
+                state: &zero,
+            };
+            let (si, sj) = model.state(&law, &side(i), &side(j), &bonds.geom[b], &bonds.history[b]);
+            add_assign(&mut p.state[i], &si);
+            add_assign(&mut p.state[j], &sj);
         }
     }
-    p.state = sum;
 }
 
 /// Turns summed states into final values (after the reverse sum brought ghosts' partials home).

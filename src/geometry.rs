@@ -379,8 +379,9 @@ pub struct Cloud {
     pub position: Vec<Vec3>,
     pub volume: Vec<f64>,
     pub material: Vec<u16>,
-    /// Lattice spacing (or bar particle spacing) of each particle: partial-volume correction and time-step estimates need it.
-    /// For bar particles this is the realised spacing len/n, not the requested one.
+    /// Lattice spacing (or bar particle spacing) of each particle; for bar particles the
+    /// realised spacing len/n. Reported for inspection: the engine's partial-volume factor uses
+    /// the lattice spacing for every bond, bar bonds included.
     pub spacing: Vec<f64>,
 }
 

@@ -230,8 +230,9 @@ fn run_setup<M: Model>(
 
     let mut progress = Progress::new(steps, scene.output.progress && !opts.quiet);
     let wall = Instant::now();
+    let mut broken = setup.sim.bonds.broken_count();
     for step in 1..=steps {
-        setup.sim.advance();
+        broken += setup.sim.advance();
         let last = step == steps;
         let want_row = step % every == 0 || last;
         let want_frame = frames_every > 0 && (step % frames_every == 0 || last);
@@ -249,7 +250,7 @@ fn run_setup<M: Model>(
             }
             setup.sim.timing.lap(Phase::Output, t);
         }
-        progress.update(step, setup.sim.bonds.broken_count());
+        progress.update(step, broken);
     }
     history.flush().map_err(io)?;
     let seconds = wall.elapsed().as_secs_f64();

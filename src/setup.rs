@@ -109,8 +109,28 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         scene.partial_volume,
     );
 
+    // Particles in one place (overlapping bars, say) would make a bond of length zero.
+    if let Some((i, j, _)) = bonds
+        .iter()
+        .find(|&(_, _, b)| bonds.geom[b].length < 1e-6 * scene.spacing)
+    {
+        return Err(scene.error(
+            None,
+            format!(
+                "particles {} and {} coincide (at {:?} and {:?}): overlapping bars or shapes put two particles in one place",
+                particles.gid[i], particles.gid[j], particles.x0[i], particles.x0[j]
+            ),
+        ));
+    }
+
     // Time step.
     let (dt_critical, dt_critical_particle) = stable_time_step(&model, &particles, &bonds);
+    if !(dt_critical > 0.0) {
+        return Err(scene.error(
+            None,
+            format!("the stable time step is {dt_critical:e}: check the materials' stiffness and density"),
+        ));
+    }
     if !dt_critical.is_finite() {
         return Err(scene.error(
             None,

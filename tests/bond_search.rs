@@ -40,3 +40,33 @@ proptest! {
         prop_assert_eq!(total as usize, 2 * bonds.len());
     }
 }
+
+/// Lattices whose extent is a whole number of horizons, at spacings not exact in binary: the
+/// cells must not lose pairs at exactly the horizon, and ghosts (particles past `n_owned`) are
+/// bonded to owned particles only.
+#[test]
+fn lattice_pairs_at_exactly_the_horizon_are_found() {
+    for (h, origin, n) in [
+        (1.0 / 3.0, 0.0, 31usize),
+        (0.02, 0.013, 91),
+        (0.001, 0.0, 40),
+    ] {
+        let x: Vec<[f64; 3]> = (0..n).map(|i| [origin + i as f64 * h, 0.0, 0.0]).collect();
+        let horizon = 3.0 * h;
+        let bonds = BondList::<()>::find(&x, x.len(), horizon, h, true);
+        assert_eq!(
+            bonds.len(),
+            3 * n - 6,
+            "spacing {h}: every pair up to 3 apart"
+        );
+        let n_owned = n / 2;
+        let ghosts = BondList::<()>::find(&x, n_owned, horizon, h, true);
+        for (i, j, _) in ghosts.iter() {
+            assert!(i < n_owned, "a ghost owns a bond");
+            assert!(j < n_owned || i + 3 >= n_owned, "bond {i}-{j} too far");
+        }
+        // Owned-owned pairs plus owned-ghost pairs.
+        let expect = (3 * n_owned - 6) + 6;
+        assert_eq!(ghosts.len(), expect, "spacing {h}");
+    }
+}

@@ -419,3 +419,43 @@ velocity = "30 -5 2 m/s"
         );
     }
 }
+
+#[test]
+fn bonds_at_exactly_the_horizon_are_all_kept() {
+    // m = 3 on a 1 mm lattice puts 30 of an interior particle's 122 neighbours at exactly the
+    // horizon; rounding of the coordinates must not decide which of them bond. The origin is
+    // shifted to an awkward value so the coordinates are not exact in binary.
+    let text = block(9, 9, 9, "", "[time]\nsteps = 1\n")
+        .replace("horizon = \"3.015 mm\"", "m = 3")
+        .replace(
+            "spacing = \"1 mm\"",
+            "spacing = \"1 mm\"\norigin = \"0.013 0.027 0.0031 mm\"",
+        )
+        .replace("min = \"0 0 0 mm\"", "min = \"0.013 0.027 0.0031 mm\"")
+        .replace("max = \"9 9 9 mm\"", "max = \"9.013 9.027 9.0031 mm\"");
+    let s = setup_pmb(&text);
+    let p = &s.sim.particles;
+    assert_eq!(p.n_owned, 729);
+    let centre = (0..p.n_owned)
+        .min_by(|&a, &b| {
+            let d = |i: usize| {
+                (0..3)
+                    .map(|k| (p.x0[i][k] * 1e3 - 4.5).powi(2))
+                    .sum::<f64>()
+            };
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    assert_eq!(s.sim.bonds.initial[centre], 122);
+    // Every interior particle (3 spacings from every face) has the full family.
+    for i in 0..p.n_owned {
+        let x = p.x0[i].map(|c| c * 1e3);
+        let inner = [0.013, 0.027, 0.0031]
+            .iter()
+            .enumerate()
+            .all(|(k, o)| x[k] - o > 3.4 && x[k] - o < 5.6);
+        if inner {
+            assert_eq!(s.sim.bonds.initial[i], 122, "particle {i} at {x:?}");
+        }
+    }
+}
