@@ -1077,7 +1077,7 @@ impl Converter {
             }
             (None, Some(v), None) => {
                 let dofs = comps(&b.components)?;
-                let v = v.value(self.sys);
+                let v = self.finite3(v.value(self.sys), line, &format!("{ctx}: velocity"))?;
                 (
                     dofs.clone(),
                     Motion::Velocity(dofs.iter().map(|&d| v[d]).collect()),
@@ -1085,7 +1085,7 @@ impl Converter {
             }
             (None, None, Some(u)) => {
                 let dofs = comps(&b.components)?;
-                let u = u.value(self.sys);
+                let u = self.finite3(u.value(self.sys), line, &format!("{ctx}: displacement"))?;
                 (
                     dofs.clone(),
                     Motion::Displacement(dofs.iter().map(|&d| u[d]).collect()),

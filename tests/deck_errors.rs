@@ -683,3 +683,40 @@ fn duplicate_probe_name() {
         Some(line),
     );
 }
+
+/// TOML's `nan` is a float: a velocity made of it would fill the run with NaN.
+#[test]
+fn nan_in_a_boundary_velocity() {
+    let deck = edit("fixed = [\"all\"]", "velocity = [nan, 0, 0]");
+    let line = line_of(&deck, "[[boundary]]");
+    assert_rejected(
+        "nan_velocity",
+        &deck,
+        &["clamp", "velocity", "finite"],
+        Some(line),
+    );
+}
+
+/// Two bars along the same line put particles on top of each other (a bond of length zero).
+#[test]
+fn overlapping_bars() {
+    let bar = "[[bar]]\nmaterial = \"mortar\"\narea = \"1 mm^2\"\nfrom = \"0.2 3.2 3.2 mm\"\nto = \"5.2 3.2 3.2 mm\"\n";
+    let deck = insert_before_time(&format!("{bar}\n{bar}"));
+    assert_rejected(
+        "overlapping_bars",
+        &deck,
+        &["coincide", "overlapping"],
+        None,
+    );
+}
+
+/// A history table with a NaN time would make the load factor undefined.
+#[test]
+fn nan_in_a_history_table() {
+    let deck = edit(
+        "fixed = [\"all\"]",
+        "displacement = \"0 0 1 mm\"\nhistory = { table = [[0, 0], [nan, 1]] }",
+    );
+    let line = line_of(&deck, "[[boundary]]");
+    assert_rejected("nan_history", &deck, &["history", "finite"], Some(line));
+}
