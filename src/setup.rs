@@ -125,7 +125,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
 
     // Time step.
     let (dt_critical, dt_critical_particle) = stable_time_step(&model, &particles, &bonds);
-    if !(dt_critical > 0.0) {
+    if dt_critical.is_nan() || dt_critical <= 0.0 {
         return Err(scene.error(
             None,
             format!("the stable time step is {dt_critical:e}: check the materials' stiffness and density"),
