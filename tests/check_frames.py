@@ -29,7 +29,7 @@ for e in entries:
     assert sorted(mesh.point_data["id"]) == list(range(n)), "ids are 0..n-1"
 last = meshio.read(out / entries[-1].get("file"))
 rows = list(csv.DictReader(open(out / "history.csv")))
-assert float(rows[-1]["max_damage"]) == last.point_data["damage"].max()
+assert abs(float(rows[-1]["max_damage"]) - last.point_data["damage"].max()) < 1e-9
 print(f"frames ok: {len(entries)} frames of {len(last.points)} particles, "
       f"max damage {last.point_data['damage'].max():.3f}, "
       f"{int(float(rows[-1]['broken_bonds']))} broken bonds")
