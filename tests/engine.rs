@@ -459,3 +459,19 @@ fn bonds_at_exactly_the_horizon_are_all_kept() {
         }
     }
 }
+
+#[test]
+fn the_same_deck_gives_bit_identical_results() {
+    let text = std::fs::read_to_string("inputs/pmb_block.toml").unwrap();
+    let run = || {
+        let mut s = setup_pmb(&text);
+        for _ in 0..400 {
+            s.sim.advance();
+        }
+        s
+    };
+    let (a, b) = (run(), run());
+    assert!(a.sim.bonds.broken_count() > 0, "the run should crack");
+    assert_eq!(a.sim.bonds.broken, b.sim.bonds.broken);
+    assert!(a.sim.particles.alter == b.sim.particles.alter);
+}
