@@ -275,6 +275,15 @@ fn run_setup<M: Model>(
             steps, seconds, summary.broken
         );
         eprint!("{}", summary.timing);
+        eprintln!(
+            "results    {}: history.csv, timing.txt{}",
+            summary.output.display(),
+            if frames.is_some() {
+                ", frames.pvd (open in ParaView; colour by damage)"
+            } else {
+                ""
+            }
+        );
     }
     Ok(summary)
 }
