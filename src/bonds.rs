@@ -134,6 +134,37 @@ impl<H: Attributes> BondList<H> {
         }
     }
 
+    /// A bond list from bonds already found elsewhere (the wall method's per-procCube search):
+    /// owner `i` holds `partner[offsets[i]..offsets[i + 1]]`; `initial` counts both ends.
+    pub fn assemble(
+        offsets: Vec<u32>,
+        partner: Vec<u32>,
+        geom: Vec<BondGeom>,
+        initial: Vec<u32>,
+    ) -> BondList<H> {
+        assert!(
+            offsets.last().map(|&o| o as usize) == Some(partner.len())
+                && geom.len() == partner.len()
+                && offsets.windows(2).all(|w| w[0] <= w[1]),
+            "inconsistent bond list"
+        );
+        let n = partner.len();
+        let max_partner = partner.iter().map(|&j| j as usize).max().unwrap_or(0);
+        assert!(
+            max_partner < initial.len().max(1),
+            "bond partner out of range"
+        );
+        BondList {
+            offsets,
+            partner,
+            max_partner,
+            geom,
+            broken: vec![false; n],
+            history: vec![H::default(); n],
+            initial,
+        }
+    }
+
     pub fn len(&self) -> usize {
         self.partner.len()
     }

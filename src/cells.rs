@@ -4,22 +4,24 @@
 //! Pairing each cell with itself and with the 13 neighbours of [`HALF_SHELL`] visits every
 //! adjacent pair of cells exactly once, so every pair of particles is found exactly once.
 
-/// Forward neighbours: (dx, dy, dz) with dz > 0, or dz = 0 and dy > 0, or dz = dy = 0 and dx > 0.
-/// Their negatives are the other 13 of the 26 neighbours.
+/// The half shell the wall method needs: (dx, dy, dz) with dy < 0, or dy = 0 and dz < 0, or
+/// dy = dz = 0 and dx < 0. Every offset has dy ≤ 0, so a procCube pairs its cells only with
+/// ghosts from the south, down, up-south and west sides — exactly what the five ghost messages
+/// deliver (nothing ever comes from the north). Their negatives are the other 13 neighbours.
 pub const HALF_SHELL: [[i32; 3]; 13] = [
-    [1, 0, 0],
-    [-1, 1, 0],
-    [0, 1, 0],
-    [1, 1, 0],
+    [-1, -1, -1],
+    [0, -1, -1],
+    [1, -1, -1],
+    [-1, -1, 0],
+    [0, -1, 0],
+    [1, -1, 0],
     [-1, -1, 1],
     [0, -1, 1],
     [1, -1, 1],
-    [-1, 0, 1],
-    [0, 0, 1],
-    [1, 0, 1],
-    [-1, 1, 1],
-    [0, 1, 1],
-    [1, 1, 1],
+    [-1, 0, -1],
+    [0, 0, -1],
+    [1, 0, -1],
+    [-1, 0, 0],
 ];
 
 /// A box of cells over a set of points.
@@ -150,6 +152,7 @@ mod tests {
         all.dedup();
         assert_eq!(all.len(), 26);
         assert!(!all.contains(&[0, 0, 0]));
+        assert!(HALF_SHELL.iter().all(|o| o[1] <= 0));
     }
 
     #[test]

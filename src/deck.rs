@@ -6,6 +6,7 @@
 //! (see [`crate::units`]); anything semantically wrong is reported with the entry's line.
 
 use crate::boundary::{History, Motion};
+use crate::decomposition::{Procs, Walls};
 use crate::geometry::{Bar, Lattice, Op, Shape};
 use crate::model::{Material, MaterialKind};
 use crate::simulation::Integrator;
@@ -64,6 +65,24 @@ struct DeckFile {
     output: Option<Spanned<OutputSection>>,
     #[serde(default)]
     probe: Vec<Spanned<ProbeSection>>,
+    #[serde(default)]
+    parallel: Option<Spanned<ParallelSection>>,
+}
+
+/// `procs` is `[nx, ny, nz]` or `"auto"`.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum ProcsSpec {
+    Given([i64; 3]),
+    Word(String),
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct ParallelSection {
+    procs: Option<ProcsSpec>,
+    threads: Option<i64>,
+    walls: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -83,6 +102,9 @@ struct ModelSection {
 struct LatticeSection {
     spacing: Length,
     origin: Option<Position>,
+    /// Axes that wrap around ("x", "y", "z"): the lattice box repeats along them.
+    #[serde(default)]
+    periodic: Vec<String>,
 }
 
 #[derive(Deserialize)]
@@ -235,6 +257,16 @@ pub enum RunLength {
     Duration(f64),
 }
 
+/// How the run is cut into procCubes and run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParallelSpec {
+    pub line: usize,
+    pub procs: Procs,
+    /// Worker threads (one procCube each) when not under MPI.
+    pub threads: usize,
+    pub walls: Walls,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct TimeSpec {
     pub length: RunLength,
@@ -301,6 +333,9 @@ pub struct ProbeSpec {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
     pub file: String,
+    /// Axes that wrap around.
+    pub periodic: [bool; 3],
+    pub parallel: ParallelSpec,
     pub title: String,
     pub units: UnitSystem,
     pub model: String,
@@ -466,6 +501,7 @@ impl Converter {
                 format!("lattice spacing must be > 0 (got {spacing})"),
             );
         }
+        let lattice_periodic = deck.lattice.get_ref().periodic.clone();
         let origin = deck
             .lattice
             .get_ref()
@@ -655,6 +691,23 @@ impl Converter {
             frames_every: out.frames_every.unwrap_or(0),
             progress: out.progress.unwrap_or(true),
         };
+        let parallel = self.parallel(deck.parallel.as_ref())?;
+        let mut periodic = [false; 3];
+        for a in &lattice_periodic {
+            match a.as_str() {
+                "x" => periodic[0] = true,
+                "y" => periodic[1] = true,
+                "z" => periodic[2] = true,
+                other => {
+                    return self.err(
+                        lat_line,
+                        format!(
+                        "[lattice] periodic: unknown axis '{other}' (use \"x\", \"y\" or \"z\")"
+                    ),
+                    )
+                }
+            }
+        }
         let mut probes = Vec::new();
         for p in &deck.probe {
             let line = self.line_of(p);
@@ -677,6 +730,8 @@ impl Converter {
 
         Ok(Scene {
             file: self.file.clone(),
+            periodic,
+            parallel,
             title: deck.title.unwrap_or_else(|| stem.to_string()),
             units: sys,
             model: ms.name,
@@ -705,6 +760,65 @@ impl Converter {
             initial,
             output,
             probes,
+        })
+    }
+
+    fn parallel(&self, section: Option<&Spanned<ParallelSection>>) -> R<ParallelSpec> {
+        let (p, line) = match section {
+            Some(p) => (p.get_ref(), self.line_of(p)),
+            None => (&ParallelSection::default(), 0),
+        };
+        let procs = match &p.procs {
+            None => Procs::Auto,
+            Some(ProcsSpec::Word(w)) if w == "auto" => Procs::Auto,
+            Some(ProcsSpec::Word(w)) => {
+                return self.err(
+                    line,
+                    format!("[parallel] procs = \"{w}\": give [nx, ny, nz] or \"auto\""),
+                )
+            }
+            Some(ProcsSpec::Given(v)) => {
+                if v.iter().any(|&n| n < 1) {
+                    return self.err(
+                        line,
+                        format!("[parallel] procs = {v:?}: every count must be at least 1"),
+                    );
+                }
+                Procs::Given(v.map(|n| n as usize))
+            }
+        };
+        let threads = match (p.threads, &procs) {
+            (Some(t), _) if t < 1 => {
+                return self.err(line, format!("[parallel] threads = {t}: must be at least 1"))
+            }
+            (Some(t), Procs::Given(v)) if t as usize != v.iter().product::<usize>() => {
+                return self.err(
+                    line,
+                    format!(
+                        "[parallel] threads = {t} but procs = {v:?} makes {} procCubes; give one procCube per thread",
+                        v.iter().product::<usize>()
+                    ),
+                )
+            }
+            (Some(t), _) => t as usize,
+            (None, Procs::Given(v)) => v.iter().product(),
+            (None, Procs::Auto) => 1,
+        };
+        let walls = match p.walls.as_deref() {
+            None | Some("whole") => Walls::Whole,
+            Some("trimmed") => Walls::Trimmed,
+            Some(other) => {
+                return self.err(
+                    line,
+                    format!("[parallel] walls = \"{other}\": use \"whole\" or \"trimmed\""),
+                )
+            }
+        };
+        Ok(ParallelSpec {
+            line,
+            procs,
+            threads,
+            walls,
         })
     }
 

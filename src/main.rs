@@ -30,6 +30,15 @@ enum Cmd {
         /// Print nothing but errors.
         #[arg(long)]
         quiet: bool,
+        /// Worker threads, one procCube each (not under mpirun, where each rank is one).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// ProcCubes along x, y and z, as NXxNYxNZ (e.g. 2x2x1), or "auto".
+        #[arg(long, value_parser = parse_procs)]
+        procs: Option<pdq::decomposition::Procs>,
+        /// Ghost messages: "whole" walls or "trimmed" to the cells each neighbour needs.
+        #[arg(long, value_parser = parse_walls)]
+        walls: Option<pdq::decomposition::Walls>,
     },
     /// Check a deck: particles, bonds, memory, time step, and an estimated run time.
     Check { deck: PathBuf },
@@ -63,6 +72,9 @@ fn main() -> ExitCode {
             steps,
             output,
             quiet,
+            threads,
+            procs,
+            walls,
         } => deck::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| {
@@ -72,6 +84,12 @@ fn main() -> ExitCode {
                         steps,
                         output,
                         quiet,
+                        threads: threads.or(procs.as_ref().and_then(|p| match p {
+                            pdq::decomposition::Procs::Given(v) => Some(v.iter().product()),
+                            pdq::decomposition::Procs::Auto => None,
+                        })),
+                        procs,
+                        walls,
                     },
                 )
             })
@@ -107,6 +125,31 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+fn parse_procs(s: &str) -> Result<pdq::decomposition::Procs, String> {
+    if s == "auto" {
+        return Ok(pdq::decomposition::Procs::Auto);
+    }
+    let v: Vec<usize> = s
+        .split('x')
+        .map(|p| p.trim().parse::<usize>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{s}': give NXxNYxNZ, e.g. 2x2x1, or auto"))?;
+    match v.as_slice() {
+        &[x, y, z] if x > 0 && y > 0 && z > 0 => Ok(pdq::decomposition::Procs::Given([x, y, z])),
+        _ => Err(format!(
+            "'{s}': give three counts of at least 1, e.g. 2x2x1"
+        )),
+    }
+}
+
+fn parse_walls(s: &str) -> Result<pdq::decomposition::Walls, String> {
+    match s {
+        "whole" => Ok(pdq::decomposition::Walls::Whole),
+        "trimmed" => Ok(pdq::decomposition::Walls::Trimmed),
+        _ => Err(format!("'{s}': use whole or trimmed")),
     }
 }
 

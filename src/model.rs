@@ -184,7 +184,7 @@ impl<M: Model> Side<'_, M> {
 /// Layout convention for `Alter`: the first `Force::LEN` values are the generalized
 /// coordinates (current position first), the next `Force::LEN` their velocities; anything after
 /// that is free for the model. The integrators rely on it, so a model needs no integration code.
-pub trait Model: Sized + Send + Sync + 'static {
+pub trait Model: Sized + Clone + Send + Sync + 'static {
     /// The name a deck uses (`[model] name = "…"`).
     const NAME: &'static str;
     /// One line for `pdq models`.

@@ -1,8 +1,12 @@
 //! `pdq run` and `pdq check`: drive a simulation built from a deck and report on it.
 
+use crate::attributes::Attributes;
+use crate::comm::{f64s, Reduce, Team, Transport};
 use crate::deck::Scene;
+use crate::decomposition::{Layout, Procs, Walls};
 use crate::model::{Model, ModelVisitor};
 use crate::output::{Frames, History, Progress};
+use crate::parallel::{self, Cube};
 use crate::particles::Particles;
 use crate::setup::{self, Setup};
 use crate::timing::Phase;
@@ -23,6 +27,11 @@ pub struct Summary {
     pub output: PathBuf,
     pub seconds: f64,
     pub timing: String,
+    pub layout: String,
+    /// Final positions by global id, and the broken bonds as sorted global id pairs (when the
+    /// deck asks for `final_state`, or for tests).
+    pub positions: Vec<[f64; 3]>,
+    pub broken_pairs: Vec<(u32, u32)>,
 }
 
 /// Options the command line may set over the deck.
@@ -31,6 +40,10 @@ pub struct RunOptions {
     pub steps: Option<u64>,
     pub output: Option<PathBuf>,
     pub quiet: bool,
+    /// Worker threads (one procCube each); the deck's `[parallel] threads` otherwise.
+    pub threads: Option<usize>,
+    pub procs: Option<Procs>,
+    pub walls: Option<Walls>,
 }
 
 /// Runs a deck to the end.
@@ -84,18 +97,11 @@ fn dof_name(d: usize) -> String {
     }
 }
 
-fn row<M: Model>(setup: &Setup<M>, damage: &[f64]) -> Vec<f64> {
-    let sim = &setup.sim;
+/// One procCube's share of a history row, reduced over all procCubes; the root gets the row.
+fn row<M: Model>(cube: &mut Cube<M>, damage: &[f64], n_probes: usize) -> Vec<f64> {
+    let sim = &cube.sim;
     let (ke, se) = (sim.kinetic_energy(), sim.strain_energy());
-    let mut r = vec![
-        sim.step as f64,
-        sim.time,
-        ke,
-        se,
-        ke + se,
-        sim.bonds.broken_count() as f64,
-        damage.iter().cloned().fold(0.0, f64::max),
-    ];
+    let mut sums = vec![ke, se, sim.bonds.broken_count() as f64];
     for l in &sim.loads {
         let t = l.total(sim.time);
         let norm = (l.vector[0].powi(2) + l.vector[1].powi(2) + l.vector[2].powi(2)).sqrt();
@@ -104,15 +110,412 @@ fn row<M: Model>(setup: &Setup<M>, damage: &[f64]) -> Vec<f64> {
         } else {
             0.0
         };
-        r.push(along);
+        sums.push(along);
     }
     for b in &sim.constraints {
-        r.extend_from_slice(&b.reaction);
+        sums.extend_from_slice(&b.reaction);
     }
-    for (_, i) in &setup.probes {
-        r.extend_from_slice(&sim.particles.displacement(*i));
+    let first_probe = sums.len();
+    sums.resize(first_probe + 3 * n_probes, 0.0);
+    for &(k, i) in &cube.probes {
+        sums[first_probe + 3 * k..first_probe + 3 * k + 3]
+            .copy_from_slice(&sim.particles.displacement(i));
     }
+    let (step, time) = (sim.step as f64, sim.time);
+    let mut team = Team::new(cube.sim.exchange.transport());
+    team.reduce(&mut sums, Reduce::Sum);
+    let max_damage = team.max(damage.iter().cloned().fold(0.0, f64::max));
+    let mut r = vec![
+        step,
+        time,
+        sums[0],
+        sums[1],
+        sums[0] + sums[1],
+        sums[2],
+        max_damage,
+    ];
+    r.extend_from_slice(&sums[3..]);
     r
+}
+
+/// True on every worker if any worker failed (so that all stop together, none left waiting).
+fn any_failed<M: Model>(cube: &mut Cube<M>, failed: bool) -> bool {
+    Team::new(cube.sim.exchange.transport()).max(if failed { 1.0 } else { 0.0 }) > 0.0
+}
+
+/// Owned particles' global indices, alterable records and damage, gathered on the root.
+fn gather_frame<M: Model>(cube: &mut Cube<M>, damage: &[f64], store: &mut Option<FrameStore<M>>) {
+    let n = cube.sim.particles.n_owned;
+    let mut mine = Vec::with_capacity(n * (2 + <M::Alter as Attributes>::LEN));
+    for i in 0..n {
+        mine.push(cube.plan.global[i] as f64);
+        mine.push(damage[i]);
+        mine.extend_from_slice(cube.sim.particles.alter[i].as_slice());
+    }
+    let all = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&mine));
+    if let (Some(all), Some(store)) = (all, store.as_mut()) {
+        let len = 2 + <M::Alter as Attributes>::LEN;
+        for bytes in all {
+            for rec in f64s(&bytes).chunks_exact(len) {
+                let g = rec[0] as usize;
+                store.damage[g] = rec[1];
+                store.particles.alter[g]
+                    .as_mut_slice()
+                    .copy_from_slice(&rec[2..]);
+            }
+        }
+    }
+}
+
+/// The whole scene on the root, refreshed from all procCubes for each frame.
+struct FrameStore<M: Model> {
+    particles: Particles<M>,
+    damage: Vec<f64>,
+}
+
+/// What every worker needs to know about the run beyond its own procCube.
+struct Plan {
+    columns: Vec<String>,
+    dir: PathBuf,
+    steps: u64,
+    every: u64,
+    frames_every: u64,
+    progress: bool,
+    quiet: bool,
+    n_probes: usize,
+    layout: String,
+}
+
+/// The step loop of one worker; the root (rank 0) writes the output and returns the summary.
+fn drive<M: Model>(
+    mut cube: Cube<M>,
+    plan: &Plan,
+    mut store: Option<FrameStore<M>>,
+) -> Result<Option<Summary>, String> {
+    let root = cube.sim.exchange.transport().rank() == 0;
+    let t = Instant::now();
+    cube.start();
+    cube.sim.timing.lap(Phase::Setup, t);
+    let dir = &plan.dir;
+    let io = |e: std::io::Error| format!("writing output in {}: {e}", dir.display());
+
+    let mut error: Option<String> = None;
+    let mut history = None;
+    let mut frames = None;
+    if root {
+        match History::create(&dir.join("history.csv"), &plan.columns) {
+            Ok(h) => history = Some(h),
+            Err(e) => error = Some(io(e)),
+        }
+        if plan.frames_every > 0 && error.is_none() {
+            match Frames::new(dir) {
+                Ok(f) => frames = Some(f),
+                Err(e) => error = Some(io(e)),
+            }
+        }
+    }
+    let mut progress = Progress::new(plan.steps, root && plan.progress && !plan.quiet);
+    let wall = Instant::now();
+    let mut broken = 0usize;
+    for step in 0..=plan.steps {
+        if step > 0 {
+            cube.sim.advance();
+        }
+        let last = step == plan.steps;
+        let want_row = step % plan.every == 0 || last;
+        let want_frame = plan.frames_every > 0 && (step % plan.frames_every == 0 || last);
+        if want_row || want_frame {
+            let t = Instant::now();
+            if any_failed(&mut cube, error.is_some()) {
+                return Err(error.unwrap_or_else(|| "another worker failed".into()));
+            }
+            let damage = cube.damage();
+            if want_row {
+                let r = row(&mut cube, &damage, plan.n_probes);
+                broken = r[5] as usize;
+                if let Some(h) = history.as_mut() {
+                    if let Err(e) = h.row(&r) {
+                        error = Some(io(e));
+                    }
+                }
+            }
+            if want_frame {
+                gather_frame(&mut cube, &damage, &mut store);
+                if let (Some(f), Some(s)) = (frames.as_mut(), store.as_ref()) {
+                    if let Err(e) = f.write(step, cube.sim.time, &s.particles, &s.damage) {
+                        error = Some(io(e));
+                    }
+                }
+            }
+            cube.sim.timing.lap(Phase::Output, t);
+        }
+        progress.update(step, broken);
+    }
+    if any_failed(&mut cube, error.is_some()) {
+        return Err(error.unwrap_or_else(|| "another worker failed".into()));
+    }
+    let seconds = wall.elapsed().as_secs_f64();
+
+    // Totals, the final state, and where each procCube's time went.
+    let n_global = cube.global_particles;
+    let mut totals = [
+        cube.sim.bonds.len() as f64,
+        cube.sim.bonds.broken_count() as f64,
+        cube.sim.kinetic_energy(),
+        cube.sim.strain_energy(),
+    ];
+    Team::new(cube.sim.exchange.transport()).reduce(&mut totals, Reduce::Sum);
+    let mut mine: Vec<f64> = Vec::new();
+    for i in 0..cube.sim.particles.n_owned {
+        mine.push(cube.sim.particles.gid[i] as f64);
+        mine.extend_from_slice(&cube.sim.particles.pos(i));
+    }
+    let positions = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&mine));
+    let pairs: Vec<f64> = cube
+        .broken_pairs()
+        .iter()
+        .flat_map(|&(a, b)| [a as f64, b as f64])
+        .collect();
+    let pairs = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&pairs));
+    let traffic = cube.wall().traffic;
+    let tm = &cube.sim.timing;
+    let balance = [
+        cube.sim.particles.n_owned as f64,
+        cube.plan.ghosts() as f64,
+        tm.get(Phase::Forces).as_secs_f64() + tm.get(Phase::State).as_secs_f64(),
+        tm.get(Phase::Communication).as_secs_f64(),
+        tm.total().as_secs_f64()
+            - tm.get(Phase::Setup).as_secs_f64()
+            - tm.get(Phase::Output).as_secs_f64(),
+        traffic.bytes as f64,
+    ];
+    let balance = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&balance));
+    if !root {
+        return Ok(None);
+    }
+    let mut position = vec![[f64::NAN; 3]; n_global];
+    for bytes in positions.unwrap_or_default() {
+        for rec in f64s(&bytes).chunks_exact(4) {
+            position[rec[0] as usize] = [rec[1], rec[2], rec[3]];
+        }
+    }
+    let mut broken_pairs: Vec<(u32, u32)> = pairs
+        .unwrap_or_default()
+        .iter()
+        .flat_map(|b| {
+            f64s(b)
+                .chunks_exact(2)
+                .map(|c| (c[0] as u32, c[1] as u32))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    broken_pairs.sort_unstable();
+    let balance: Vec<Vec<f64>> = balance
+        .unwrap_or_default()
+        .iter()
+        .map(|b| f64s(b))
+        .collect();
+    let mut timing = cube.sim.timing.table(n_global as f64 * plan.steps as f64);
+    if balance.len() > 1 {
+        timing.push_str(&balance_table(&balance, plan.steps));
+    }
+    if let Some(h) = history.as_mut() {
+        h.flush().map_err(io)?;
+    }
+    std::fs::write(dir.join("timing.txt"), &timing).map_err(io)?;
+    Ok(Some(Summary {
+        particles: n_global,
+        bonds: totals[0] as usize,
+        steps: plan.steps,
+        dt: cube.sim.dt,
+        broken: totals[1] as usize,
+        kinetic_energy: totals[2],
+        strain_energy: totals[3],
+        output: plan.dir.clone(),
+        seconds,
+        timing,
+        layout: plan.layout.clone(),
+        positions: position,
+        broken_pairs,
+    }))
+}
+
+/// Particles and time per procCube, max/mean, and the share of time spent communicating.
+fn balance_table(rows: &[Vec<f64>], steps: u64) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<9} {:>10} {:>8} {:>10} {:>10} {:>10} {:>12}",
+        "procCube", "particles", "ghosts", "forces s", "comm s", "step s", "bytes/step"
+    );
+    for (k, r) in rows.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "{:<9} {:>10} {:>8} {:>10.3} {:>10.3} {:>10.3} {:>12.0}",
+            k,
+            r[0],
+            r[1],
+            r[2],
+            r[3],
+            r[4],
+            r[5] / steps.max(1) as f64
+        );
+    }
+    let col = |c: usize| -> (f64, f64) {
+        let max = rows.iter().map(|r| r[c]).fold(0.0, f64::max);
+        let mean = rows.iter().map(|r| r[c]).sum::<f64>() / rows.len() as f64;
+        (max, mean)
+    };
+    let (pmax, pmean) = col(0);
+    let (fmax, fmean) = col(2);
+    let (cmax, _) = col(3);
+    let (smax, _) = col(4);
+    let _ = writeln!(
+        s,
+        "load balance: particles max/mean {:.3}, force time max/mean {:.3}; communication {:.1}% of the slowest step loop",
+        pmax / pmean.max(1e-300),
+        fmax / fmean.max(1e-300),
+        100.0 * cmax / smax.max(1e-300)
+    );
+    s
+}
+
+/// The layout, and how many workers: MPI ranks when launched by `mpirun`, threads otherwise.
+fn choose_layout<M: Model>(
+    setup: &Setup<M>,
+    scene: &Scene,
+    opts: &RunOptions,
+    workers: usize,
+) -> Result<Layout, String> {
+    let procs = opts.procs.clone().unwrap_or(scene.parallel.procs.clone());
+    let walls = opts.walls.unwrap_or(scene.parallel.walls);
+    parallel::layout(setup, &procs, workers, walls).map_err(|e| {
+        if scene.parallel.line > 0 && opts.procs.is_none() {
+            format!("{}:{}: {e}", scene.file, scene.parallel.line)
+        } else {
+            e
+        }
+    })
+}
+
+fn run_setup<M: Model>(
+    mut setup: Setup<M>,
+    scene: &Scene,
+    opts: &RunOptions,
+) -> Result<Summary, String> {
+    if let Some(n) = opts.steps {
+        setup.steps = n;
+    }
+    let dir = opts
+        .output
+        .clone()
+        .unwrap_or_else(|| scene.output.directory.clone());
+    let plan = |layout: &Layout| Plan {
+        columns: columns(&setup),
+        dir: dir.clone(),
+        steps: setup.steps,
+        every: scene.output.history_every,
+        frames_every: scene.output.frames_every,
+        progress: scene.output.progress,
+        quiet: opts.quiet,
+        n_probes: setup.probes.len(),
+        layout: layout.describe(),
+    };
+
+    #[cfg(feature = "mpi")]
+    if crate::comm_mpi::launched_by_mpirun() {
+        let mpi = crate::comm_mpi::Mpi::init().ok_or("MPI was already initialized")?;
+        let (rank, ranks) = (mpi.rank(), mpi.size());
+        let layout = choose_layout(&setup, scene, opts, ranks)?;
+        if rank == 0 {
+            prepare(&setup, scene, opts, &dir, &layout, "ranks", ranks)?;
+        }
+        let plans = parallel::plans(&setup, &layout);
+        let cube = parallel::build_cube(&setup, &plans, rank, Box::new(mpi));
+        let p = plan(&layout);
+        let store = (rank == 0).then(|| frame_store(setup));
+        let summary = drive(cube, &p, store)?;
+        return match summary {
+            Some(s) => {
+                report(&s, opts, scene.output.frames_every > 0);
+                Ok(s)
+            }
+            // Other ranks have nothing to print; a summary-less Ok ends them quietly.
+            None => std::process::exit(0),
+        };
+    }
+
+    let threads = opts.threads.unwrap_or(scene.parallel.threads);
+    let layout = choose_layout(&setup, scene, opts, threads)?;
+    prepare(&setup, scene, opts, &dir, &layout, "threads", threads)?;
+    let cubes = parallel::thread_cubes(&setup, &layout);
+    let p = plan(&layout);
+    let store = std::sync::Mutex::new(Some(frame_store(setup)));
+    let results = parallel::on_threads(cubes, |cube| {
+        let s = if cube.plan.rank == 0 {
+            store.lock().unwrap().take()
+        } else {
+            None
+        };
+        drive(cube, &p, s)
+    });
+    let mut summary = None;
+    for r in results {
+        if let Some(s) = r? {
+            summary = Some(s);
+        }
+    }
+    let summary = summary.ok_or("the root procCube returned no summary")?;
+    report(&summary, opts, scene.output.frames_every > 0);
+    Ok(summary)
+}
+
+fn frame_store<M: Model>(setup: Setup<M>) -> FrameStore<M> {
+    let n = setup.sim.particles.len();
+    FrameStore {
+        particles: setup.sim.particles,
+        damage: vec![0.0; n],
+    }
+}
+
+/// Creates the output directory and prints what is about to run.
+fn prepare<M: Model>(
+    setup: &Setup<M>,
+    scene: &Scene,
+    opts: &RunOptions,
+    dir: &PathBuf,
+    layout: &Layout,
+    workers: &str,
+    n: usize,
+) -> Result<(), String> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
+    if !opts.quiet {
+        eprint!("{}", describe(setup, scene));
+        eprintln!("parallel   {} on {n} {workers}", layout.describe());
+        eprintln!("output     {}", dir.display());
+    }
+    Ok(())
+}
+
+fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
+    if opts.quiet {
+        return;
+    }
+    eprintln!(
+        "done       {} steps in {:.2} s; {} broken bonds",
+        summary.steps, summary.seconds, summary.broken
+    );
+    eprint!("{}", summary.timing);
+    eprintln!(
+        "results    {}: history.csv, timing.txt{}",
+        summary.output.display(),
+        if frames {
+            ", frames.pvd (open in ParaView; colour by damage)"
+        } else {
+            ""
+        }
+    );
 }
 
 fn material_counts<M: Model>(p: &Particles<M>, scene: &Scene) -> String {
@@ -189,103 +592,6 @@ fn describe<M: Model>(setup: &Setup<M>, scene: &Scene) -> String {
         );
     }
     s
-}
-
-fn run_setup<M: Model>(
-    mut setup: Setup<M>,
-    scene: &Scene,
-    opts: &RunOptions,
-) -> Result<Summary, String> {
-    if let Some(n) = opts.steps {
-        setup.steps = n;
-    }
-    let dir = opts
-        .output
-        .clone()
-        .unwrap_or_else(|| scene.output.directory.clone());
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
-    if !opts.quiet {
-        eprint!("{}", describe(&setup, scene));
-        eprintln!("output     {}", dir.display());
-    }
-    let io = |e: std::io::Error| format!("writing output in {}: {e}", dir.display());
-    let mut history = History::create(&dir.join("history.csv"), &columns(&setup)).map_err(io)?;
-    let mut frames = if scene.output.frames_every > 0 {
-        Some(Frames::new(&dir).map_err(io)?)
-    } else {
-        None
-    };
-    let every = scene.output.history_every;
-    let frames_every = scene.output.frames_every;
-    let steps = setup.steps;
-
-    let t = Instant::now();
-    let damage = setup.sim.bonds.damage(setup.sim.particles.len());
-    history.row(&row(&setup, &damage)).map_err(io)?;
-    if let Some(f) = frames.as_mut() {
-        f.write(0, 0.0, &setup.sim.particles, &damage).map_err(io)?;
-    }
-    setup.sim.timing.lap(Phase::Output, t);
-
-    let mut progress = Progress::new(steps, scene.output.progress && !opts.quiet);
-    let wall = Instant::now();
-    let mut broken = setup.sim.bonds.broken_count();
-    for step in 1..=steps {
-        broken += setup.sim.advance();
-        let last = step == steps;
-        let want_row = step % every == 0 || last;
-        let want_frame = frames_every > 0 && (step % frames_every == 0 || last);
-        if want_row || want_frame {
-            let t = Instant::now();
-            let damage = setup.sim.bonds.damage(setup.sim.particles.len());
-            if want_row {
-                history.row(&row(&setup, &damage)).map_err(io)?;
-            }
-            if want_frame {
-                if let Some(f) = frames.as_mut() {
-                    f.write(step, setup.sim.time, &setup.sim.particles, &damage)
-                        .map_err(io)?;
-                }
-            }
-            setup.sim.timing.lap(Phase::Output, t);
-        }
-        progress.update(step, broken);
-    }
-    history.flush().map_err(io)?;
-    let seconds = wall.elapsed().as_secs_f64();
-    let n = setup.sim.particles.n_owned;
-    let timing = setup.sim.timing.table(n as f64 * steps as f64);
-    std::fs::write(dir.join("timing.txt"), &timing).map_err(io)?;
-    let summary = Summary {
-        particles: n,
-        bonds: setup.sim.bonds.len(),
-        steps,
-        dt: setup.sim.dt,
-        broken: setup.sim.bonds.broken_count(),
-        kinetic_energy: setup.sim.kinetic_energy(),
-        strain_energy: setup.sim.strain_energy(),
-        output: dir,
-        seconds,
-        timing,
-    };
-    if !opts.quiet {
-        eprintln!(
-            "done       {} steps in {:.2} s; {} broken bonds",
-            steps, seconds, summary.broken
-        );
-        eprint!("{}", summary.timing);
-        eprintln!(
-            "results    {}: history.csv, timing.txt{}",
-            summary.output.display(),
-            if frames.is_some() {
-                ", frames.pvd (open in ParaView; colour by damage)"
-            } else {
-                ""
-            }
-        );
-    }
-    Ok(summary)
 }
 
 /// `pdq check`: builds everything, times a few steps and reports without running.

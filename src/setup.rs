@@ -6,6 +6,7 @@ use crate::bonds::BondList;
 use crate::boundary::{Constraint, Load};
 use crate::cells::CellGrid;
 use crate::deck::{DeckError, LoadKind, Region, RunLength, Scene};
+use crate::decomposition::Domain;
 use crate::geometry;
 use crate::model::{Model, ModelBuild, ModelVisitor};
 use crate::particles::Particles;
@@ -22,6 +23,13 @@ pub struct Setup<M: Model> {
     /// Probe name and the store index of the particle nearest to it.
     pub probes: Vec<(String, usize)>,
     pub seconds: f64,
+    /// The cells the wall method cuts into procCubes (the store is in their order).
+    pub domain: Domain,
+    /// Store indices of the particles of cell `c`: `cell_start[c]..cell_start[c + 1]`.
+    pub cell_start: Vec<u32>,
+    pub horizon: f64,
+    pub spacing: f64,
+    pub partial_volume: bool,
 }
 
 /// Builds the model named by the deck and hands it to `visitor`.
@@ -89,9 +97,10 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         scene.error(line, e.message.clone())
     })?;
 
-    // Store particles in cell order so that bond partners are near each other in memory.
-    let grid = CellGrid::covering(&cloud.position, scene.horizon);
-    let (_, _, order) = grid.bin(&cloud.position);
+    // Store particles in cell order so that bond partners are near each other in memory, and
+    // so that the wall method finds each cell's particles in one run.
+    let domain = domain(&cloud.position, scene)?;
+    let (_, cell_start, order) = domain.grid.bin(&cloud.position);
     let gid: Vec<u32> = order.clone();
     let x0 = order.iter().map(|&g| cloud.position[g as usize]).collect();
     let volume = order.iter().map(|&g| cloud.volume[g as usize]).collect();
@@ -261,6 +270,50 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         steps,
         probes,
         seconds,
+        domain,
+        cell_start,
+        horizon: scene.horizon,
+        spacing: scene.spacing,
+        partial_volume: scene.partial_volume,
+    })
+}
+
+/// Cells of side ≥ the horizon over the scene. A periodic axis spans the lattice box (particle
+/// positions ± half a spacing) exactly, so that its cells tile one period.
+fn domain(points: &[[f64; 3]], scene: &Scene) -> Result<Domain, DeckError> {
+    let mut grid = CellGrid::covering(points, scene.horizon);
+    let mut period = [0.0; 3];
+    for a in 0..3 {
+        if !scene.periodic[a] {
+            continue;
+        }
+        let lo = points.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min);
+        let hi = points
+            .iter()
+            .map(|p| p[a])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let length = hi - lo + scene.spacing;
+        let n = (length / (scene.horizon * (1.0 + 1e-9))).floor() as usize;
+        if n < 3 {
+            return Err(scene.error(
+                None,
+                format!(
+                    "[lattice] periodic axis {} is {:.4e} long, less than three horizons ({:.4e}); make the body longer along it or drop the axis from 'periodic'",
+                    ["x", "y", "z"][a],
+                    length,
+                    3.0 * scene.horizon
+                ),
+            ));
+        }
+        grid.origin[a] = lo - 0.5 * scene.spacing;
+        grid.dims[a] = n;
+        grid.size[a] = length / n as f64;
+        period[a] = length;
+    }
+    Ok(Domain {
+        grid,
+        periodic: scene.periodic,
+        period,
     })
 }
 

@@ -10,10 +10,12 @@
 use crate::attributes::Attributes;
 use crate::bonds::BondList;
 use crate::boundary::{Constraint, Load};
+use crate::comm::{Solo, Transport};
 use crate::forces;
 use crate::model::Model;
 use crate::particles::Particles;
 use crate::timing::{Phase, Timing};
+use crate::wall::WallExchange;
 use std::time::Instant;
 
 /// Time integration of the generalized degrees of freedom.
@@ -44,11 +46,22 @@ pub trait Exchange<M: Model> {
     fn forward_state(&mut self, _p: &mut Particles<M>) {}
     /// Generalized forces on ghosts back to their owners (summed on arrival).
     fn reverse_force(&mut self, _p: &mut Particles<M>) {}
+    /// The byte mover underneath, for reductions and gathers at output time.
+    fn transport(&mut self) -> &mut dyn Transport;
+    /// The wall-method exchange, if this is one.
+    fn wall(&mut self) -> Option<&mut WallExchange> {
+        None
+    }
 }
 
 /// One procCube, no ghosts: nothing to move.
-pub struct Local;
-impl<M: Model> Exchange<M> for Local {}
+#[derive(Default)]
+pub struct Local(Solo);
+impl<M: Model> Exchange<M> for Local {
+    fn transport(&mut self) -> &mut dyn Transport {
+        &mut self.0
+    }
+}
 
 pub struct Simulation<M: Model> {
     pub model: M,
@@ -77,7 +90,7 @@ impl<M: Model> Simulation<M> {
             time: 0.0,
             step: 0,
             timing: Timing::default(),
-            exchange: Box::new(Local),
+            exchange: Box::new(Local::default()),
         }
     }
 

@@ -40,6 +40,7 @@ fn quick_example_runs_and_cracks() {
             steps: None,
             output: Some(dir.clone()),
             quiet: true,
+            ..Default::default()
         },
     )
     .unwrap();

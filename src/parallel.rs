@@ -1,0 +1,248 @@
+//! From one built scene to procCubes that step on their own: each gets its owned particles,
+//! its ghosts, the bonds it evaluates, its share of the boundary conditions and loads, and a
+//! [`WallExchange`] over whatever transport the run uses (threads or MPI ranks).
+//!
+//! Every worker builds the whole scene (deterministic), then keeps its procCube; this keeps
+//! setup and its error messages in one place, at the price of each worker holding the scene
+//! once while it starts.
+
+use crate::attributes::Attributes;
+use crate::bonds::BondList;
+use crate::boundary::{Constraint, Load};
+use crate::comm::Transport;
+use crate::decomposition::{cell_plans, cube_plan, CellPlan, CubePlan, Layout, Procs, Walls};
+use crate::model::Model;
+use crate::particles::Particles;
+use crate::setup::Setup;
+use crate::simulation::Simulation;
+use crate::wall::WallExchange;
+
+/// One procCube ready to step.
+pub struct Cube<M: Model> {
+    pub sim: Simulation<M>,
+    pub plan: CubePlan,
+    /// Probe number and local index, for the probes whose particle this procCube owns.
+    pub probes: Vec<(usize, usize)>,
+    /// Global particle count of the scene.
+    pub global_particles: usize,
+}
+
+/// The layout a run asks for: `procs` from the deck or command line, `workers` threads or ranks.
+pub fn layout<M: Model>(
+    setup: &Setup<M>,
+    procs: &Procs,
+    workers: usize,
+    walls: Walls,
+) -> Result<Layout, String> {
+    let counts = cell_counts(&setup.cell_start);
+    match procs {
+        Procs::Auto => Layout::auto(workers, &setup.domain, &counts, walls),
+        Procs::Given(p) => {
+            let n: usize = p.iter().product();
+            if n != workers {
+                return Err(format!(
+                    "procs = {p:?} makes {n} procCubes but the run has {workers} worker{} (threads or MPI ranks); one procCube per worker",
+                    if workers == 1 { "" } else { "s" }
+                ));
+            }
+            Layout::new(*p, &setup.domain, &counts, walls)
+        }
+    }
+}
+
+fn cell_counts(cell_start: &[u32]) -> Vec<u32> {
+    cell_start.windows(2).map(|w| w[1] - w[0]).collect()
+}
+
+/// The cell plans of all procCubes (computed identically by every worker).
+pub fn plans<M: Model>(setup: &Setup<M>, layout: &Layout) -> Vec<CellPlan> {
+    cell_plans(&setup.domain, layout)
+}
+
+/// Builds procCube `rank` from the whole scene.
+pub fn build_cube<M: Model>(
+    setup: &Setup<M>,
+    plans: &[CellPlan],
+    rank: usize,
+    transport: Box<dyn Transport>,
+) -> Cube<M> {
+    let plan = cube_plan(&setup.domain, plans, rank, &setup.cell_start);
+    let g = &setup.sim.particles;
+    let idx = |l: usize| plan.global[l] as usize;
+    let n = plan.global.len();
+    let x0: Vec<[f64; 3]> = (0..n)
+        .map(|l| {
+            let (x, s) = (g.x0[idx(l)], plan.shift[l]);
+            [x[0] + s[0], x[1] + s[1], x[2] + s[2]]
+        })
+        .collect();
+    let mut p = Particles::new(
+        &setup.sim.model,
+        (0..n).map(|l| g.gid[idx(l)]).collect(),
+        x0,
+        (0..n).map(|l| g.volume[idx(l)]).collect(),
+        (0..n).map(|l| g.material[idx(l)]).collect(),
+    );
+    p.n_owned = plan.n_owned;
+    for l in 0..n {
+        let mut a = g.alter[idx(l)];
+        let s = plan.shift[l];
+        let v = a.as_mut_slice();
+        for k in 0..3 {
+            v[k] += s[k];
+        }
+        p.alter[l] = a;
+    }
+    let bonds: BondList<M::Bond> =
+        plan.find_bonds(&p.x0, setup.horizon, setup.spacing, setup.partial_volume);
+
+    // Global store index → local index, for owned particles.
+    let mut local = vec![u32::MAX; g.len()];
+    for l in 0..plan.n_owned {
+        local[idx(l)] = l as u32;
+    }
+    let owned = |list: &[u32]| -> Vec<(usize, u32)> {
+        list.iter()
+            .enumerate()
+            .filter(|(_, &gi)| local[gi as usize] != u32::MAX)
+            .map(|(k, &gi)| (k, local[gi as usize]))
+            .collect()
+    };
+    let mut sim = Simulation::new(setup.sim.model.clone(), p, bonds, setup.sim.dt);
+    sim.integrator = setup.sim.integrator;
+    sim.constraints = setup
+        .sim
+        .constraints
+        .iter()
+        .map(|c| {
+            Constraint::new(
+                &c.name,
+                owned(&c.particles).into_iter().map(|(_, l)| l).collect(),
+                c.dofs.clone(),
+                c.motion.clone(),
+                c.history.clone(),
+            )
+        })
+        .collect();
+    sim.loads = setup
+        .sim
+        .loads
+        .iter()
+        .map(|l| {
+            let mine = owned(&l.particles);
+            Load {
+                name: l.name.clone(),
+                particles: mine.iter().map(|&(_, i)| i).collect(),
+                weight: mine.iter().map(|&(k, _)| l.weight[k]).collect(),
+                vector: l.vector,
+                history: l.history.clone(),
+            }
+        })
+        .collect();
+    let probes = setup
+        .probes
+        .iter()
+        .enumerate()
+        .filter(|(_, (_, gi))| local[*gi] != u32::MAX)
+        .map(|(k, (_, gi))| (k, local[*gi] as usize))
+        .collect();
+    let stages = plan.stages.clone();
+    sim.exchange = Box::new(WallExchange::new(stages, transport));
+    Cube {
+        sim,
+        plan,
+        probes,
+        global_particles: g.len(),
+    }
+}
+
+impl<M: Model> Cube<M> {
+    /// Makes the bond counts of owned particles whole (bonds evaluated on a neighbour count
+    /// there) and computes the first forces. Every worker must call it, as it exchanges.
+    pub fn start(&mut self) {
+        let mut counts: Vec<f64> = self.sim.bonds.initial.iter().map(|&c| c as f64).collect();
+        self.wall().reverse(&mut counts, |a, b| *a += b);
+        for (c, v) in self.sim.bonds.initial.iter_mut().zip(&counts) {
+            *c = *v as u32;
+        }
+        for c in &self.sim.constraints {
+            c.set_velocity(&mut self.sim.particles, 0.0, self.sim.dt);
+        }
+        self.sim.compute_forces();
+    }
+
+    pub fn wall(&mut self) -> &mut WallExchange {
+        self.sim
+            .exchange
+            .wall()
+            .expect("a procCube always has a wall exchange")
+    }
+
+    /// Damage of the owned particles: broken over initial bonds, counting bonds evaluated on
+    /// neighbouring procCubes (exchanges, so every worker must call it).
+    pub fn damage(&mut self) -> Vec<f64> {
+        let n = self.sim.particles.len();
+        let mut broken = vec![0.0f64; n];
+        let b = &self.sim.bonds;
+        for (i, j, k) in b.iter() {
+            if b.broken[k] {
+                broken[i] += 1.0;
+                broken[j] += 1.0;
+            }
+        }
+        self.wall().reverse(&mut broken, |a, b| *a += b);
+        let b = &self.sim.bonds;
+        (0..self.sim.particles.n_owned)
+            .map(|i| {
+                if b.initial[i] == 0 {
+                    0.0
+                } else {
+                    broken[i] / b.initial[i] as f64
+                }
+            })
+            .collect()
+    }
+
+    /// The broken bonds of this procCube as (smaller, larger) global id pairs.
+    pub fn broken_pairs(&self) -> Vec<(u32, u32)> {
+        let b = &self.sim.bonds;
+        let gid = &self.sim.particles.gid;
+        b.iter()
+            .filter(|&(_, _, k)| b.broken[k])
+            .map(|(i, j, _)| (gid[i].min(gid[j]), gid[i].max(gid[j])))
+            .collect()
+    }
+}
+
+/// Builds every procCube of `layout` for threads of this process.
+pub fn thread_cubes<M: Model>(setup: &Setup<M>, layout: &Layout) -> Vec<Cube<M>> {
+    let plans = plans(setup, layout);
+    crate::comm::Threads::team(layout.cubes())
+        .into_iter()
+        .enumerate()
+        .map(|(k, t)| build_cube(setup, &plans, k, Box::new(t)))
+        .collect()
+}
+
+/// Runs `work` on every procCube, each on its own thread, and returns their results in order.
+pub fn on_threads<M: Model, R: Send>(
+    cubes: Vec<Cube<M>>,
+    work: impl Fn(Cube<M>) -> R + Sync,
+) -> Vec<R> {
+    if cubes.len() == 1 {
+        return cubes.into_iter().map(&work).collect();
+    }
+    std::thread::scope(|s| {
+        let handles: Vec<_> = cubes
+            .into_iter()
+            .map(|c| {
+                let w = &work;
+                s.spawn(move || w(c))
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
+}
