@@ -3,7 +3,10 @@
 fn main() {
     let opts = pdq::bench::BenchOptions {
         model: "pmb".into(),
-        threads: 1,
+        threads: vec![1],
+        ranks: vec![],
+        walls: pdq::decomposition::Walls::Whole,
+        yardstick: true,
         steps: 100,
         n: 40,
         peer: false,

@@ -5,9 +5,11 @@
 //! what the generic model path costs.
 
 use crate::deck;
+use crate::decomposition::{Procs, Walls};
 use crate::forces;
 use crate::model::{Model, ModelVisitor};
 use crate::models::pmb::{Motion, Pmb};
+use crate::parallel;
 use crate::setup;
 use std::fmt::Write as _;
 use std::process::Command;
@@ -16,7 +18,13 @@ use std::time::Instant;
 #[derive(Clone, Debug)]
 pub struct BenchOptions {
     pub model: String,
-    pub threads: usize,
+    /// Thread counts to time, one line each.
+    pub threads: Vec<usize>,
+    /// MPI rank counts to time (each through `mpirun`), one line each.
+    pub ranks: Vec<usize>,
+    pub walls: Walls,
+    /// Whether to time the yardstick (generic against hand-written PMB loop).
+    pub yardstick: bool,
     pub steps: u64,
     /// Lattice cells per edge: (n + 1)³ particles; 40 is the standard scene.
     pub n: usize,
@@ -89,11 +97,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Runs the benchmark and returns the lines it printed.
 pub fn run(opts: &BenchOptions) -> Result<String, String> {
-    if opts.threads != 1 {
-        return Err(format!(
-            "threads = {}: this build runs one procCube per process; multi-threaded procCubes come with the wall-method decomposition",
-            opts.threads
-        ));
+    if opts.threads.contains(&0) || opts.ranks.contains(&0) {
+        return Err("threads and ranks must be at least 1".into());
     }
     let text = standard_deck(&opts.model, opts.n, opts.steps)?;
     let scene = deck::parse(&text, "<bench>", "bench").map_err(|e| e.to_string())?;
@@ -105,53 +110,167 @@ pub fn run(opts: &BenchOptions) -> Result<String, String> {
             bench_setup(setup, self.1)
         }
     }
+    #[cfg(feature = "mpi")]
+    if crate::comm_mpi::launched_by_mpirun() {
+        return setup::with_model(&scene, MpiVisit(&scene, opts)).map_err(|e| e.to_string())?;
+    }
     let (mut out, ours) =
         setup::with_model(&scene, Visit(&scene, opts)).map_err(|e| e.to_string())??;
+    for &r in &opts.ranks {
+        out.push_str(&ranks_line(opts, r)?);
+    }
     if opts.peer {
-        match peer(opts)? {
-            Ok((line, theirs)) => {
-                out.push_str(&line);
-                let _ = writeln!(
-                    out,
-                    "bench ratio lammps/pdq={:.2} (model={} vs peri/pmb, 1 core each)",
-                    theirs / ours,
-                    opts.model
-                );
+        for &t in &opts.threads {
+            match peer(opts, t)? {
+                Ok((line, theirs)) => {
+                    out.push_str(&line);
+                    if t == 1 {
+                        let _ = writeln!(
+                            out,
+                            "bench ratio lammps/pdq={:.2} (model={} vs peri/pmb, 1 core each)",
+                            theirs / ours,
+                            opts.model
+                        );
+                    }
+                }
+                Err(skipped) => out.push_str(&skipped),
             }
-            Err(skipped) => out.push_str(&skipped),
         }
     }
     Ok(out)
+}
+
+/// The standard line of one parallel run.
+fn line(
+    model: &str,
+    particles: usize,
+    steps: u64,
+    threads: usize,
+    ranks: usize,
+    t: &parallel::Timed,
+) -> String {
+    format!(
+        "bench model={model} particles={particles} steps={steps} threads={threads} ranks={ranks} us_per_particle_step={:.4} ns_per_bond={:.3} bonds={} broken={} seconds={:.3} comm_percent={:.1} bytes_per_step={:.0}",
+        1e6 * t.seconds / (particles as f64 * steps as f64),
+        1e9 * t.seconds / (t.bonds as f64 * steps as f64),
+        t.bonds,
+        t.broken,
+        t.seconds,
+        100.0 * t.comm_seconds / t.seconds.max(1e-300),
+        t.bytes_per_step
+    )
+}
+
+/// Under `mpirun`: this rank's procCube of the standard scene; rank 0 prints the line.
+#[cfg(feature = "mpi")]
+struct MpiVisit<'a>(&'a deck::Scene, &'a BenchOptions);
+#[cfg(feature = "mpi")]
+impl ModelVisitor for MpiVisit<'_> {
+    type Output = Result<String, String>;
+    fn visit<M: Model>(self, model: M) -> Self::Output {
+        use crate::comm::Transport;
+        let mpi = crate::comm_mpi::Mpi::init().ok_or("MPI was already initialized")?;
+        let (rank, ranks) = (mpi.rank(), mpi.size());
+        let setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
+        let layout = parallel::layout(&setup, &Procs::Auto, ranks, self.1.walls)?;
+        let plans = parallel::plans(&layout);
+        let cube = parallel::build_cube(&setup, &layout, &plans, rank, Box::new(mpi));
+        let n = setup.sim.particles.len();
+        drop(setup);
+        let t = cube.timed_steps(self.1.steps);
+        Ok(if rank == 0 {
+            format!(
+                "{} layout={}\n",
+                line(M::NAME, n, self.1.steps, 1, ranks, &t),
+                layout.describe().replace(' ', "_")
+            )
+        } else {
+            String::new()
+        })
+    }
+}
+
+/// Runs this program's bench under `mpirun -np ranks` and returns its line.
+fn ranks_line(opts: &BenchOptions, ranks: usize) -> Result<String, String> {
+    if !cfg!(feature = "mpi") {
+        return Ok(format!(
+            "bench ranks={ranks} skipped: this pdq was built without the 'mpi' feature (cargo build --release --features mpi)\n"
+        ));
+    }
+    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
+    let out = Command::new("mpirun")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .args(["--oversubscribe", "-np"])
+        .arg(ranks.to_string())
+        .arg(exe)
+        .args(["bench", "--model", &opts.model, "--threads", "1", "--steps"])
+        .arg(opts.steps.to_string())
+        .arg("--n")
+        .arg(opts.n.to_string())
+        .args(["--walls", opts.walls.name()])
+        .output();
+    match out {
+        Ok(o) if o.status.success() => Ok(String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .filter(|l| l.starts_with("bench"))
+            .map(|l| format!("{l}\n"))
+            .collect()),
+        Ok(o) => Err(format!(
+            "mpirun -np {ranks} failed: {}",
+            String::from_utf8_lossy(&o.stderr)
+        )),
+        Err(e) => Ok(format!(
+            "bench ranks={ranks} skipped: cannot run mpirun ({e}); install openmpi-bin\n"
+        )),
+    }
 }
 
 fn bench_setup<M: Model>(
     mut setup: setup::Setup<M>,
     opts: &BenchOptions,
 ) -> Result<(String, f64), String> {
-    let sim = &mut setup.sim;
-    let n = sim.particles.n_owned;
-    let bonds = sim.bonds.len();
-    let t = Instant::now();
-    for _ in 0..opts.steps {
-        sim.advance();
-    }
-    let secs = t.elapsed().as_secs_f64();
-    let ps = (n as u64 * opts.steps) as f64;
-    let us = 1e6 * secs / ps;
+    let n = setup.sim.particles.n_owned;
     let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "bench model={} particles={n} steps={} threads={} ranks=1 us_per_particle_step={:.4} ns_per_bond={:.3} bonds={bonds} broken={} seconds={:.3}",
-        M::NAME,
-        opts.steps,
-        opts.threads,
-        us,
-        1e9 * secs / (bonds as f64 * opts.steps as f64),
-        sim.bonds.broken_count(),
-        secs
-    );
-    for line in sim.timing.table(0.0).lines() {
-        let _ = writeln!(out, "# {line}");
+    let mut one_thread = None;
+    for &threads in &opts.threads {
+        let layout = parallel::layout(&setup, &Procs::Auto, threads, opts.walls)?;
+        let cubes = parallel::thread_cubes(&setup, &layout);
+        let timed = parallel::on_threads(cubes, |c| c.timed_steps(opts.steps));
+        let t = &timed[0];
+        let us = 1e6 * t.seconds / (n as f64 * opts.steps as f64);
+        let _ = write!(out, "{}", line(M::NAME, n, opts.steps, threads, 1, t));
+        match one_thread {
+            None if threads == 1 => one_thread = Some(us),
+            Some(base) => {
+                let _ = write!(out, " speedup={:.2}", base / us);
+            }
+            None => {}
+        }
+        let _ = writeln!(out, " layout={}", layout.describe().replace(' ', "_"));
+        if timed.len() > 1 {
+            for (k, c) in timed.iter().enumerate() {
+                use crate::timing::Phase;
+                let _ = writeln!(
+                    out,
+                    "# procCube {k}: forces {:.3} s, communication {:.3} s, integration {:.3} s",
+                    c.timing.get(Phase::Forces).as_secs_f64(),
+                    c.timing.get(Phase::Communication).as_secs_f64(),
+                    c.timing.get(Phase::Integration).as_secs_f64()
+                );
+            }
+        }
+        for l in t.timing.table(0.0).lines() {
+            let _ = writeln!(out, "# {l}");
+        }
+    }
+    let ours = one_thread.unwrap_or(f64::NAN);
+    if !opts.yardstick {
+        return Ok((out, ours));
+    }
+    let sim = &mut setup.sim;
+    for _ in 0..2 {
+        sim.advance();
     }
     // The yardstick: the generic pair pass against a hand-written PMB loop on the same state.
     // Runs alternate (hand first on even repeats, generic first on odd ones) and the overhead
@@ -211,7 +330,7 @@ fn bench_setup<M: Model>(
             opts.repeat.max(1)
         );
     }
-    Ok((out, us))
+    Ok((out, ours))
 }
 
 /// The PMB force pass written by hand for this one model: the yardstick of the generic path.
@@ -265,13 +384,24 @@ pub fn hand_pmb_pass(
 /// LAMMPS `peri/pmb` on the same scene: `Ok(Ok((line, µs per particle-step)))`, or
 /// `Ok(Err(line))` saying why it was skipped (no `lmp` on the PATH).
 #[allow(clippy::type_complexity)]
-fn peer(opts: &BenchOptions) -> Result<Result<(String, f64), String>, String> {
+fn peer(opts: &BenchOptions, ranks: usize) -> Result<Result<(String, f64), String>, String> {
     let lmp = std::env::var("PDQ_LMP").unwrap_or_else(|_| "lmp".into());
     let dir = std::env::temp_dir().join(format!("pdq-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let input = dir.join("lammps_pmb.in");
     std::fs::write(&input, LAMMPS_PMB).map_err(|e| e.to_string())?;
-    let output = Command::new(&lmp)
+    let mut cmd = if ranks > 1 {
+        let mut c = Command::new("mpirun");
+        c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+            .args(["--oversubscribe", "-np"])
+            .arg(ranks.to_string())
+            .arg(&lmp);
+        c
+    } else {
+        Command::new(&lmp)
+    };
+    let output = cmd
         .current_dir(&dir)
         .args(["-in", "lammps_pmb.in", "-var", "n"])
         .arg(opts.n.to_string())
@@ -310,7 +440,7 @@ fn peer(opts: &BenchOptions) -> Result<Result<(String, f64), String>, String> {
     let us = 1e6 * secs / (atoms * steps);
     Ok(Ok((
         format!(
-            "bench peer=lammps-peri/pmb particles={atoms} steps={steps} threads=1 ranks=1 us_per_particle_step={us:.4}\n"
+            "bench peer=lammps-peri/pmb particles={atoms} steps={steps} threads=1 ranks={ranks} us_per_particle_step={us:.4}\n"
         ),
         us,
     )))

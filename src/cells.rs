@@ -94,9 +94,11 @@ impl CellGrid {
         c
     }
 
+    /// Cells are numbered with y slowest, then z, then x: the half shell looks back at most one
+    /// y-slab, so the particles a cell's bonds touch stay close together in the store.
     #[inline]
     pub fn index(&self, c: [usize; 3]) -> usize {
-        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+        (c[1] * self.dims[2] + c[2]) * self.dims[0] + c[0]
     }
 
     /// The neighbour of cell `c` at `offset`, if inside the grid.

@@ -56,12 +56,35 @@ pub struct Domain {
 }
 
 /// ProcCubes as ranges of cell layers along each axis.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct Layout {
     pub procs: [usize; 3],
     /// `cuts[a][k]..cuts[a][k + 1]` are the cell layers of the k-th procCube along axis a.
     pub cuts: [Vec<usize>; 3],
     pub walls: Walls,
+    /// The cells, possibly coarser than the scene's along an axis so that procCubes split it
+    /// evenly (any cells of side ≥ the horizon find the same bonds).
+    pub domain: Domain,
+    /// Store indices of the particles of cell c: `order[start[c]..start[c + 1]]`, increasing.
+    pub start: Vec<u32>,
+    pub order: Vec<u32>,
+}
+
+impl Domain {
+    /// The same box with the cell count along each axis rounded down to a multiple of
+    /// `procs`, where that leaves at least one cell per procCube.
+    pub fn for_procs(&self, procs: [usize; 3]) -> Domain {
+        let mut d = self.clone();
+        for (a, &p) in procs.iter().enumerate() {
+            let n = self.grid.dims[a];
+            let m = n - n % p.max(1);
+            if m >= p && m != n {
+                d.grid.size[a] = self.grid.size[a] * n as f64 / m as f64;
+                d.grid.dims[a] = m;
+            }
+        }
+        d
+    }
 }
 
 fn layer_counts(domain: &Domain, cell_count: &[u32]) -> [Vec<u64>; 3] {
@@ -115,10 +138,11 @@ impl Layout {
     /// `cell_count` is the number of particles in each cell of the grid.
     pub fn new(
         procs: [usize; 3],
-        domain: &Domain,
-        cell_count: &[u32],
+        base: &Domain,
+        x0: &[[f64; 3]],
         walls: Walls,
     ) -> Result<Layout, String> {
+        let domain = base.for_procs(procs);
         let g = &domain.grid;
         for a in 0..3 {
             if procs[a] == 0 {
@@ -140,9 +164,18 @@ impl Layout {
                 ));
             }
         }
-        let counts = layer_counts(domain, cell_count);
+        let (_, start, order) = g.bin(x0);
+        let cell_count: Vec<u32> = start.windows(2).map(|w| w[1] - w[0]).collect();
+        let counts = layer_counts(&domain, &cell_count);
         let cuts = [0, 1, 2].map(|a| balanced_cuts(&counts[a], procs[a]));
-        Ok(Layout { procs, cuts, walls })
+        Ok(Layout {
+            procs,
+            cuts,
+            walls,
+            domain,
+            start,
+            order,
+        })
     }
 
     /// The layout of `workers` procCubes that keeps the busiest procCube least loaded (owned
@@ -150,31 +183,34 @@ impl Layout {
     pub fn auto(
         workers: usize,
         domain: &Domain,
-        cell_count: &[u32],
+        x0: &[[f64; 3]],
         walls: Walls,
     ) -> Result<Layout, String> {
         let mut best: Option<(f64, Layout)> = None;
         for px in 1..=workers {
             for py in 1..=workers / px {
-                if workers % (px * py) != 0 {
+                if !workers.is_multiple_of(px * py) {
                     continue;
                 }
                 let pz = workers / (px * py);
                 if px * py * pz != workers {
                     continue;
                 }
-                let Ok(layout) = Layout::new([px, py, pz], domain, cell_count, walls) else {
+                let Ok(layout) = Layout::new([px, py, pz], domain, x0, walls) else {
                     continue;
                 };
-                let plans = cell_plans(domain, &layout);
+                let plans = cell_plans(&layout);
+                let cell_count = layout.cell_count();
                 let cost = plans
                     .iter()
                     .map(|p| {
-                        let n = |r: Range<usize>| -> u64 {
-                            p.held[r].iter().map(|h| cell_count[h.cell] as u64).sum()
-                        };
-                        // A ghost costs packing and unpacking twice a step but no bond work.
-                        n(0..p.owned_cells) as f64 + 0.1 * n(p.owned_cells..p.held.len()) as f64
+                        let ghosts: u64 = p.held[p.owned_cells..]
+                            .iter()
+                            .map(|h| cell_count[h.cell] as u64)
+                            .sum();
+                        // Bond work grows with the candidate pairs a procCube's cells scan;
+                        // a ghost costs packing and unpacking twice a step but no bond work.
+                        pair_work(&layout.domain, p, &cell_count) + 5.0 * ghosts as f64
                     })
                     .fold(0.0, f64::max);
                 if best.as_ref().is_none_or(|(c, _)| cost < *c) {
@@ -188,6 +224,11 @@ impl Layout {
                 domain.grid.dims
             )
         })
+    }
+
+    /// Particles in each cell.
+    pub fn cell_count(&self) -> Vec<u32> {
+        self.start.windows(2).map(|w| w[1] - w[0]).collect()
     }
 
     pub fn cubes(&self) -> usize {
@@ -239,6 +280,42 @@ impl Layout {
     }
 }
 
+/// Candidate pairs the owned cells of `p` scan: each cell with itself and its half shell.
+fn pair_work(domain: &Domain, p: &CellPlan, cell_count: &[u32]) -> f64 {
+    let g = &domain.grid;
+    let count_at = |at: [i64; 3]| -> f64 {
+        let mut c = [0usize; 3];
+        for a in 0..3 {
+            let n = g.dims[a] as i64;
+            if domain.periodic[a] {
+                c[a] = at[a].rem_euclid(n) as usize;
+            } else if (0..n).contains(&at[a]) {
+                c[a] = at[a] as usize;
+            } else {
+                return 0.0;
+            }
+        }
+        cell_count[g.index(c)] as f64
+    };
+    p.held[..p.owned_cells]
+        .iter()
+        .map(|h| {
+            let n = cell_count[h.cell] as f64;
+            let around: f64 = HALF_SHELL
+                .iter()
+                .map(|o| {
+                    count_at([
+                        h.at[0] + o[0] as i64,
+                        h.at[1] + o[1] as i64,
+                        h.at[2] + o[2] as i64,
+                    ])
+                })
+                .sum();
+            n * (0.5 * n + around)
+        })
+        .sum()
+}
+
 /// A cell a procCube holds: its own, or a ghost copy of a neighbour's (maybe a periodic image).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeldCell {
@@ -268,7 +345,7 @@ pub struct CellStage {
 pub struct CellPlan {
     pub lo: [i64; 3],
     pub hi: [i64; 3],
-    /// Owned cells first (in z, y, x order), then ghosts in order of arrival.
+    /// Owned cells first (in the grid's order), then ghosts in order of arrival.
     pub held: Vec<HeldCell>,
     pub owned_cells: usize,
     pub stages: Vec<CellStage>,
@@ -287,15 +364,17 @@ impl CellPlan {
 }
 
 /// The cell plans of every procCube of `layout`.
-pub fn cell_plans(domain: &Domain, layout: &Layout) -> Vec<CellPlan> {
+pub fn cell_plans(layout: &Layout) -> Vec<CellPlan> {
+    let domain = &layout.domain;
     let g = &domain.grid;
     let n = layout.cubes();
     let mut plans: Vec<CellPlan> = (0..n)
         .map(|k| {
             let (lo, hi) = layout.cube_box(k);
             let mut held = Vec::new();
-            for z in lo[2]..hi[2] {
-                for y in lo[1]..hi[1] {
+            // The grid's own order (y slowest), which keeps bond partners close in memory.
+            for y in lo[1]..hi[1] {
+                for z in lo[2]..hi[2] {
                     for x in lo[0]..hi[0] {
                         held.push(HeldCell {
                             at: [x, y, z],
@@ -466,9 +545,9 @@ pub struct CubePlan {
     pub stages: Vec<Stage>,
 }
 
-/// The particle-level plan of procCube `rank`. `cell_start[c]..cell_start[c + 1]` are the
-/// global store indices of the particles in grid cell `c` (the global store is in cell order).
-pub fn cube_plan(domain: &Domain, plans: &[CellPlan], rank: usize, cell_start: &[u32]) -> CubePlan {
+/// The particle-level plan of procCube `rank`.
+pub fn cube_plan(layout: &Layout, plans: &[CellPlan], rank: usize) -> CubePlan {
+    let (domain, cell_start, order) = (&layout.domain, &layout.start, &layout.order);
     let plan = &plans[rank];
     let ranges = |p: &CellPlan| -> Vec<Range<usize>> {
         let mut next = 0;
@@ -486,7 +565,7 @@ pub fn cube_plan(domain: &Domain, plans: &[CellPlan], rank: usize, cell_start: &
     let mut shift = Vec::new();
     for h in &plan.held {
         let s = [0, 1, 2].map(|a| h.wraps[a] as f64 * domain.period[a]);
-        for g in cell_start[h.cell]..cell_start[h.cell + 1] {
+        for &g in &order[cell_start[h.cell] as usize..cell_start[h.cell + 1] as usize] {
             global.push(g);
             shift.push(s);
         }

@@ -48,8 +48,18 @@ enum Cmd {
     Bench {
         #[arg(long, default_value = "pmb")]
         model: String,
-        #[arg(long, default_value_t = 1)]
-        threads: usize,
+        /// Thread counts to time, comma-separated (one procCube per thread).
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+        /// MPI rank counts to time through mpirun, comma-separated (needs the `mpi` feature).
+        #[arg(long, value_delimiter = ',')]
+        ranks: Vec<usize>,
+        /// Ghost messages: whole walls or trimmed.
+        #[arg(long, value_parser = parse_walls, default_value = "whole")]
+        walls: pdq::decomposition::Walls,
+        /// Skip the generic-against-hand-written force pass comparison.
+        #[arg(long)]
+        no_yardstick: bool,
         #[arg(long, default_value_t = 200)]
         steps: u64,
         /// Lattice cells per edge ((n+1)³ particles); 40 is the standard scene.
@@ -105,6 +115,9 @@ fn main() -> ExitCode {
         Cmd::Bench {
             model,
             threads,
+            ranks,
+            walls,
+            no_yardstick,
             steps,
             n,
             peer,
@@ -112,6 +125,9 @@ fn main() -> ExitCode {
         } => bench::run(&bench::BenchOptions {
             model,
             threads,
+            ranks,
+            walls,
+            yardstick: !no_yardstick,
             steps,
             n,
             peer,

@@ -34,9 +34,9 @@ pub fn layout<M: Model>(
     workers: usize,
     walls: Walls,
 ) -> Result<Layout, String> {
-    let counts = cell_counts(&setup.cell_start);
+    let x0 = &setup.sim.particles.x0;
     match procs {
-        Procs::Auto => Layout::auto(workers, &setup.domain, &counts, walls),
+        Procs::Auto => Layout::auto(workers, &setup.domain, x0, walls),
         Procs::Given(p) => {
             let n: usize = p.iter().product();
             if n != workers {
@@ -45,28 +45,25 @@ pub fn layout<M: Model>(
                     if workers == 1 { "" } else { "s" }
                 ));
             }
-            Layout::new(*p, &setup.domain, &counts, walls)
+            Layout::new(*p, &setup.domain, x0, walls)
         }
     }
 }
 
-fn cell_counts(cell_start: &[u32]) -> Vec<u32> {
-    cell_start.windows(2).map(|w| w[1] - w[0]).collect()
-}
-
 /// The cell plans of all procCubes (computed identically by every worker).
-pub fn plans<M: Model>(setup: &Setup<M>, layout: &Layout) -> Vec<CellPlan> {
-    cell_plans(&setup.domain, layout)
+pub fn plans(layout: &Layout) -> Vec<CellPlan> {
+    cell_plans(layout)
 }
 
 /// Builds procCube `rank` from the whole scene.
 pub fn build_cube<M: Model>(
     setup: &Setup<M>,
+    layout: &Layout,
     plans: &[CellPlan],
     rank: usize,
     transport: Box<dyn Transport>,
 ) -> Cube<M> {
-    let plan = cube_plan(&setup.domain, plans, rank, &setup.cell_start);
+    let plan = cube_plan(layout, plans, rank);
     let g = &setup.sim.particles;
     let idx = |l: usize| plan.global[l] as usize;
     let n = plan.global.len();
@@ -216,11 +213,11 @@ impl<M: Model> Cube<M> {
 
 /// Builds every procCube of `layout` for threads of this process.
 pub fn thread_cubes<M: Model>(setup: &Setup<M>, layout: &Layout) -> Vec<Cube<M>> {
-    let plans = plans(setup, layout);
+    let plans = plans(layout);
     crate::comm::Threads::team(layout.cubes())
         .into_iter()
         .enumerate()
-        .map(|(k, t)| build_cube(setup, &plans, k, Box::new(t)))
+        .map(|(k, t)| build_cube(setup, layout, &plans, k, Box::new(t)))
         .collect()
 }
 
@@ -245,4 +242,57 @@ pub fn on_threads<M: Model, R: Send>(
             .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
             .collect()
     })
+}
+
+/// What one timed stretch of steps measured, reduced over all procCubes.
+#[derive(Clone, Debug)]
+pub struct Timed {
+    /// Wall time of the slowest procCube.
+    pub seconds: f64,
+    pub bonds: usize,
+    pub broken: usize,
+    /// The root procCube's phase table.
+    pub timing: crate::timing::Timing,
+    /// Bytes each procCube sent per step, summed over procCubes.
+    pub bytes_per_step: f64,
+    /// The slowest procCube's communication time (including waiting for neighbours).
+    pub comm_seconds: f64,
+}
+
+impl<M: Model> Cube<M> {
+    /// Runs `steps` steps after a common start and measures them (every worker must call it).
+    pub fn timed_steps(mut self, steps: u64) -> Timed {
+        use crate::comm::{Reduce, Team};
+        use crate::timing::Phase;
+        self.start();
+        self.sim.timing = Default::default();
+        let before = self.wall().traffic;
+        // A reduction is a barrier: everyone starts the clock together.
+        Team::new(self.sim.exchange.transport()).sum(0.0);
+        let t = std::time::Instant::now();
+        for _ in 0..steps {
+            self.sim.advance();
+        }
+        let secs = t.elapsed().as_secs_f64();
+        let after = self.wall().traffic;
+        let mut v = [
+            secs,
+            self.sim.timing.get(Phase::Communication).as_secs_f64(),
+        ];
+        Team::new(self.sim.exchange.transport()).reduce(&mut v, Reduce::Max);
+        let mut s = [
+            self.sim.bonds.len() as f64,
+            self.sim.bonds.broken_count() as f64,
+            (after.bytes - before.bytes) as f64 / steps.max(1) as f64,
+        ];
+        Team::new(self.sim.exchange.transport()).reduce(&mut s, Reduce::Sum);
+        Timed {
+            seconds: v[0],
+            comm_seconds: v[1],
+            bonds: s[0] as usize,
+            broken: s[1] as usize,
+            bytes_per_step: s[2],
+            timing: self.sim.timing.clone(),
+        }
+    }
 }

@@ -147,9 +147,9 @@ fn any_failed<M: Model>(cube: &mut Cube<M>, failed: bool) -> bool {
 fn gather_frame<M: Model>(cube: &mut Cube<M>, damage: &[f64], store: &mut Option<FrameStore<M>>) {
     let n = cube.sim.particles.n_owned;
     let mut mine = Vec::with_capacity(n * (2 + <M::Alter as Attributes>::LEN));
-    for i in 0..n {
+    for (i, &d) in damage.iter().enumerate().take(n) {
         mine.push(cube.plan.global[i] as f64);
-        mine.push(damage[i]);
+        mine.push(d);
         mine.extend_from_slice(cube.sim.particles.alter[i].as_slice());
     }
     let all = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&mine));
@@ -430,8 +430,8 @@ fn run_setup<M: Model>(
         if rank == 0 {
             prepare(&setup, scene, opts, &dir, &layout, "ranks", ranks)?;
         }
-        let plans = parallel::plans(&setup, &layout);
-        let cube = parallel::build_cube(&setup, &plans, rank, Box::new(mpi));
+        let plans = parallel::plans(&layout);
+        let cube = parallel::build_cube(&setup, &layout, &plans, rank, Box::new(mpi));
         let p = plan(&layout);
         let store = (rank == 0).then(|| frame_store(setup));
         let summary = drive(cube, &p, store)?;

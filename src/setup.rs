@@ -25,8 +25,6 @@ pub struct Setup<M: Model> {
     pub seconds: f64,
     /// The cells the wall method cuts into procCubes (the store is in their order).
     pub domain: Domain,
-    /// Store indices of the particles of cell `c`: `cell_start[c]..cell_start[c + 1]`.
-    pub cell_start: Vec<u32>,
     pub horizon: f64,
     pub spacing: f64,
     pub partial_volume: bool,
@@ -100,7 +98,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     // Store particles in cell order so that bond partners are near each other in memory, and
     // so that the wall method finds each cell's particles in one run.
     let domain = domain(&cloud.position, scene)?;
-    let (_, cell_start, order) = domain.grid.bin(&cloud.position);
+    let (_, _, order) = domain.grid.bin(&cloud.position);
     let gid: Vec<u32> = order.clone();
     let x0 = order.iter().map(|&g| cloud.position[g as usize]).collect();
     let volume = order.iter().map(|&g| cloud.volume[g as usize]).collect();
@@ -271,7 +269,6 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         probes,
         seconds,
         domain,
-        cell_start,
         horizon: scene.horizon,
         spacing: scene.spacing,
         partial_volume: scene.partial_volume,

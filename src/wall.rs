@@ -76,8 +76,8 @@ impl WallExchange {
                 let mut v: T = bytemuck::pod_read_unaligned(&self.inp[k * size..(k + 1) * size]);
                 if moved {
                     let f: &mut [f64] = bytemuck::cast_slice_mut(std::slice::from_mut(&mut v));
-                    for a in 0..3 {
-                        f[a] += st.shift[a];
+                    for (x, d) in f.iter_mut().zip(st.shift) {
+                        *x += d;
                     }
                 }
                 data[i] = v;
