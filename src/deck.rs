@@ -230,6 +230,7 @@ struct OutputSection {
     history_every: Option<u64>,
     frames_every: Option<u64>,
     progress: Option<bool>,
+    final_state: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -320,6 +321,8 @@ pub struct OutputSpec {
     pub history_every: u64,
     pub frames_every: u64,
     pub progress: bool,
+    /// Write `final_positions.csv` and `broken_bonds.csv` at the end.
+    pub final_state: bool,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -690,6 +693,7 @@ impl Converter {
             history_every,
             frames_every: out.frames_every.unwrap_or(0),
             progress: out.progress.unwrap_or(true),
+            final_state: out.final_state.unwrap_or(false),
         };
         let parallel = self.parallel(deck.parallel.as_ref())?;
         let mut periodic = [false; 3];

@@ -182,6 +182,7 @@ struct Plan {
     frames_every: u64,
     progress: bool,
     quiet: bool,
+    final_state: bool,
     n_probes: usize,
     layout: String,
 }
@@ -323,6 +324,9 @@ fn drive<M: Model>(
         h.flush().map_err(io)?;
     }
     std::fs::write(dir.join("timing.txt"), &timing).map_err(io)?;
+    if plan.final_state {
+        write_final_state(dir, &position, &broken_pairs).map_err(io)?;
+    }
     Ok(Some(Summary {
         particles: n_global,
         bonds: totals[0] as usize,
@@ -338,6 +342,27 @@ fn drive<M: Model>(
         positions: position,
         broken_pairs,
     }))
+}
+
+/// Final positions by global id and the broken bonds, at full precision, for comparing runs.
+fn write_final_state(
+    dir: &std::path::Path,
+    position: &[[f64; 3]],
+    broken: &[(u32, u32)],
+) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("final_positions.csv"))?);
+    writeln!(f, "id,x,y,z")?;
+    for (g, p) in position.iter().enumerate() {
+        writeln!(f, "{g},{:.17e},{:.17e},{:.17e}", p[0], p[1], p[2])?;
+    }
+    f.flush()?;
+    let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("broken_bonds.csv"))?);
+    writeln!(f, "id_a,id_b")?;
+    for (a, b) in broken {
+        writeln!(f, "{a},{b}")?;
+    }
+    f.flush()
 }
 
 /// Particles and time per procCube, max/mean, and the share of time spent communicating.
@@ -418,6 +443,7 @@ fn run_setup<M: Model>(
         frames_every: scene.output.frames_every,
         progress: scene.output.progress,
         quiet: opts.quiet,
+        final_state: scene.output.final_state,
         n_probes: setup.probes.len(),
         layout: layout.describe(),
     };
@@ -427,9 +453,13 @@ fn run_setup<M: Model>(
         let mpi = crate::comm_mpi::Mpi::init().ok_or("MPI was already initialized")?;
         let (rank, ranks) = (mpi.rank(), mpi.size());
         let layout = choose_layout(&setup, scene, opts, ranks)?;
-        if rank == 0 {
-            prepare(&setup, scene, opts, &dir, &layout, "ranks", ranks)?;
-        }
+        // Every rank makes the directory (the same one, on a shared file system), so that a
+        // failure stops them all instead of leaving some waiting for the root.
+        let quiet = RunOptions {
+            quiet: opts.quiet || rank != 0,
+            ..opts.clone()
+        };
+        prepare(&setup, scene, &quiet, &dir, &layout, "ranks", ranks)?;
         let plans = parallel::plans(&layout);
         let cube = parallel::build_cube(&setup, &layout, &plans, rank, Box::new(mpi));
         let p = plan(&layout);

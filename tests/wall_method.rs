@@ -161,46 +161,8 @@ proptest! {
 }
 
 /// A notched block pulled apart fast enough to crack within 500 steps.
-fn fracture_deck(model_extra: &str) -> String {
-    format!(
-        r#"units = "SI"
-[model]
-name = "pmb"
-horizon = "3.015 mm"
-[lattice]
-spacing = "1 mm"
-[materials.rock]
-density = "2200 kg/m^3"
-bulk_modulus = "14.9 GPa"
-critical_stretch = 0.0005
-[[geometry]]
-shape = "box"
-material = "rock"
-min = "0 0 0 mm"
-max = "30 10 10 mm"
-[[geometry]]
-op = "subtract"
-shape = "box"
-min = "14.5 0 5 mm"
-max = "15.5 10 10 mm"
-[time]
-steps = 500
-[[boundary]]
-name = "left"
-region = {{ shape = "slab", axis = "x", from = "0 mm", to = "3 mm" }}
-fixed = ["all"]
-[[boundary]]
-name = "right"
-region = {{ shape = "slab", axis = "x", from = "27 mm", to = "30 mm" }}
-velocity = "4 0.5 0 m/s"
-components = ["x", "y"]
-history = {{ ramp = "1 us" }}
-[output]
-progress = false
-history_every = 100
-{model_extra}
-"#
-    )
+fn fracture_deck(extra: &str) -> String {
+    format!("{}\n{extra}", include_str!("decks/notched_pull.toml"))
 }
 
 fn run_layout(text: &str, procs: [usize; 3], walls: Walls) -> Summary {
@@ -269,7 +231,11 @@ fn fracture_results_do_not_depend_on_the_layout() {
             walls.name(),
             s.broken
         );
-        assert!(d <= 1e-12, "{procs:?} {}: positions differ by {d:e}", walls.name());
+        assert!(
+            d <= 1e-12,
+            "{procs:?} {}: positions differ by {d:e}",
+            walls.name()
+        );
         assert_eq!(s.bonds, reference.bonds, "{procs:?}: bond count");
         assert_eq!(
             s.broken_pairs,
@@ -428,7 +394,10 @@ fn layouts_that_cannot_work_say_what_to_change() {
         },
     )
     .unwrap_err();
-    assert!(e.contains("t.toml:") && e.contains("9 procCubes along z"), "{e}");
+    assert!(
+        e.contains("t.toml:") && e.contains("9 procCubes along z"),
+        "{e}"
+    );
 
     for (bad, what) in [
         ("procs = [0, 1, 1]", "at least 1"),
@@ -444,5 +413,8 @@ fn layouts_that_cannot_work_say_what_to_change() {
     // A periodic axis shorter than three horizons.
     let scene = deck::parse(&box_deck([8, 4, 4], 3.015, &["y"]), "t.toml", "t").unwrap();
     let e = build_as::<Pmb>(&scene).err().unwrap().to_string();
-    assert!(e.contains("periodic axis y") && e.contains("three horizons"), "{e}");
+    assert!(
+        e.contains("periodic axis y") && e.contains("three horizons"),
+        "{e}"
+    );
 }

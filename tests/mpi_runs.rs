@@ -1,0 +1,148 @@
+//! The wall method under MPI: `mpirun -np 2` and `-np 4` give the thread runs' results, and a
+//! binary built with MPI runs without `mpirun` as one rank. Needs the `mpi` feature and
+//! `mpirun` on the PATH (`.ci/run` installs Open MPI).
+#![cfg(feature = "mpi")]
+
+use pdq::deck;
+use pdq::decomposition::{Procs, Walls};
+use pdq::run::{run, RunOptions};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const DECK: &str = "tests/decks/notched_pull.toml";
+
+fn out_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pdq-mpi-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// Final positions (by id) and broken bonds that `pdq run` wrote.
+fn read_final(dir: &Path) -> (Vec<[f64; 3]>, Vec<(u32, u32)>) {
+    let pos = std::fs::read_to_string(dir.join("final_positions.csv")).unwrap();
+    let positions = pos
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            [v[1], v[2], v[3]]
+        })
+        .collect();
+    let br = std::fs::read_to_string(dir.join("broken_bonds.csv")).unwrap();
+    let broken = br
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let (a, b) = l.split_once(',').unwrap();
+            (a.parse().unwrap(), b.parse().unwrap())
+        })
+        .collect();
+    (positions, broken)
+}
+
+fn mpirun(np: usize, extra: &[&str], dir: &Path) {
+    let out = Command::new("mpirun")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .args(["--oversubscribe", "-np", &np.to_string()])
+        .arg(env!("CARGO_BIN_EXE_pdq"))
+        .args(["run", DECK, "--quiet", "--output"])
+        .arg(dir)
+        .args(extra)
+        .output()
+        .expect("mpirun must be on the PATH for the MPI tests (apt-get install openmpi-bin)");
+    assert!(
+        out.status.success(),
+        "mpirun -np {np} failed:\n{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    a.iter()
+        .zip(b)
+        .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))
+        .fold(0.0, f64::max)
+        / scale
+}
+
+#[test]
+fn mpi_ranks_agree_with_threads() {
+    let scene = deck::load(Path::new(DECK)).unwrap();
+    let threads_dir = out_dir("threads");
+    let reference = run(
+        &scene,
+        &RunOptions {
+            output: Some(threads_dir.clone()),
+            quiet: true,
+            threads: Some(4),
+            procs: Some(Procs::Given([2, 2, 1])),
+            walls: Some(Walls::Whole),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(reference.broken > 100);
+    let (ref_pos, ref_broken) = read_final(&threads_dir);
+    assert_eq!(ref_broken, reference.broken_pairs);
+
+    // Without mpirun: one rank, same answer.
+    let solo = out_dir("solo");
+    let out = Command::new(env!("CARGO_BIN_EXE_pdq"))
+        .args(["run", DECK, "--quiet", "--output"])
+        .arg(&solo)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (pos, broken) = read_final(&solo);
+    assert!(relative_difference(&ref_pos, &pos) <= 1e-12);
+    assert_eq!(broken, ref_broken, "one rank without mpirun");
+
+    for (np, extra) in [
+        (2, vec![]),
+        (4, vec!["--procs", "2x2x1"]),
+        (4, vec!["--procs", "1x2x2", "--walls", "trimmed"]),
+    ] {
+        let dir = out_dir(&format!("np{np}-{}", extra.len()));
+        mpirun(np, &extra, &dir);
+        let (pos, broken) = read_final(&dir);
+        let d = relative_difference(&ref_pos, &pos);
+        eprintln!("mpirun -np {np} {extra:?}: max relative position difference {d:.2e}");
+        assert!(d <= 1e-12, "-np {np}: positions differ by {d:e}");
+        assert_eq!(
+            broken, ref_broken,
+            "-np {np} {extra:?}: broken bonds differ"
+        );
+        // The history the root wrote matches the threads' at every row (energies to round-off).
+        let h = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+        let r = std::fs::read_to_string(threads_dir.join("history.csv")).unwrap();
+        assert_eq!(h.lines().count(), r.lines().count());
+        let _ = std::fs::remove_dir_all(dir);
+    }
+    let _ = std::fs::remove_dir_all(threads_dir);
+    let _ = std::fs::remove_dir_all(solo);
+}
+
+#[test]
+fn a_bad_layout_under_mpi_says_what_to_change() {
+    let dir = out_dir("bad");
+    let out = Command::new("mpirun")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .args(["--oversubscribe", "-np", "2"])
+        .arg(env!("CARGO_BIN_EXE_pdq"))
+        .args(["run", DECK, "--quiet", "--procs", "1x1x4", "--output"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("one procCube per worker"), "{err}");
+}
