@@ -83,6 +83,8 @@ struct ParallelSection {
     procs: Option<ProcsSpec>,
     threads: Option<i64>,
     walls: Option<String>,
+    shuffle_every: Option<i64>,
+    skin: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -266,6 +268,10 @@ pub struct ParallelSpec {
     /// Worker threads (one procCube each) when not under MPI.
     pub threads: usize,
     pub walls: Walls,
+    /// Steps between particle shuffles (0: never).
+    pub shuffle_every: u64,
+    /// Cells are the horizon times 1 + skin, so that stretched bonds stay between neighbours.
+    pub skin: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -818,11 +824,35 @@ impl Converter {
                 )
             }
         };
+        let shuffle_every = match p.shuffle_every {
+            None => 0,
+            Some(n) if n >= 0 => n as u64,
+            Some(n) => {
+                return self.err(
+                    line,
+                    format!("[parallel] shuffle_every = {n}: give a number of steps (0 = never)"),
+                )
+            }
+        };
+        let skin =
+            match p.skin {
+                None if shuffle_every > 0 => 0.25,
+                None => 0.0,
+                Some(s) if s.is_finite() && (0.0..=10.0).contains(&s) => s,
+                Some(s) => return self.err(
+                    line,
+                    format!(
+                        "[parallel] skin = {s}: give a fraction of the horizon between 0 and 10"
+                    ),
+                ),
+            };
         Ok(ParallelSpec {
             line,
             procs,
             threads,
             walls,
+            shuffle_every,
+            skin,
         })
     }
 

@@ -113,7 +113,7 @@ fn pair_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
             ]
             .iter()
             .all(|&l| l == n)
-            && bonds_max_partner < n,
+            && (bonds_max_partner < n || offsets.last() == Some(&0)),
         "bond list does not match the particle store"
     );
     let mut newly_broken = 0;

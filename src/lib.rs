@@ -24,6 +24,7 @@ pub mod parallel;
 pub mod particles;
 pub mod run;
 pub mod setup;
+pub mod shuffle;
 pub mod simulation;
 pub mod timing;
 pub mod units;

@@ -21,10 +21,95 @@ use crate::wall::WallExchange;
 pub struct Cube<M: Model> {
     pub sim: Simulation<M>,
     pub plan: CubePlan,
+    pub layout: Layout,
     /// Probe number and local index, for the probes whose particle this procCube owns.
     pub probes: Vec<(usize, usize)>,
     /// Global particle count of the scene.
     pub global_particles: usize,
+    /// The whole scene's boundary conditions, loads and probes by global id, so that a shuffle
+    /// can hand each procCube its share again.
+    pub(crate) everywhere: Everywhere,
+    /// Bonds dropped from the bond list once broken (by a shuffle), per owned particle.
+    pub lost: Vec<u32>,
+    /// Those bonds as (smaller, larger) global ids, kept by the owner of the smaller.
+    pub dropped: Vec<(u32, u32)>,
+}
+
+/// Boundary conditions, loads and probes of the whole scene, by global id.
+#[derive(Clone, Debug)]
+pub(crate) struct Everywhere {
+    pub constraints: Vec<(Constraint, Vec<u32>)>,
+    pub loads: Vec<(Load, Vec<u32>)>,
+    pub probes: Vec<u32>,
+}
+
+impl Everywhere {
+    fn of<M: Model>(setup: &Setup<M>) -> Everywhere {
+        let gid = &setup.sim.particles.gid;
+        let by_gid = |list: &[u32]| list.iter().map(|&i| gid[i as usize]).collect();
+        Everywhere {
+            constraints: setup
+                .sim
+                .constraints
+                .iter()
+                .map(|c| (c.clone(), by_gid(&c.particles)))
+                .collect(),
+            loads: setup
+                .sim
+                .loads
+                .iter()
+                .map(|l| (l.clone(), by_gid(&l.particles)))
+                .collect(),
+            probes: setup.probes.iter().map(|(_, i)| gid[*i]).collect(),
+        }
+    }
+
+    /// This procCube's share, given the local index of each owned global id (`u32::MAX` if
+    /// not owned).
+    pub fn share(&self, local: &[u32]) -> (Vec<Constraint>, Vec<Load>, Vec<(usize, usize)>) {
+        let mine = |gids: &[u32]| -> Vec<(usize, u32)> {
+            gids.iter()
+                .enumerate()
+                .filter(|(_, &g)| local[g as usize] != u32::MAX)
+                .map(|(k, &g)| (k, local[g as usize]))
+                .collect()
+        };
+        let constraints = self
+            .constraints
+            .iter()
+            .map(|(c, gids)| {
+                Constraint::new(
+                    &c.name,
+                    mine(gids).into_iter().map(|(_, l)| l).collect(),
+                    c.dofs.clone(),
+                    c.motion.clone(),
+                    c.history.clone(),
+                )
+            })
+            .collect();
+        let loads = self
+            .loads
+            .iter()
+            .map(|(l, gids)| {
+                let m = mine(gids);
+                Load {
+                    name: l.name.clone(),
+                    particles: m.iter().map(|&(_, i)| i).collect(),
+                    weight: m.iter().map(|&(k, _)| l.weight[k]).collect(),
+                    vector: l.vector,
+                    history: l.history.clone(),
+                }
+            })
+            .collect();
+        let probes = self
+            .probes
+            .iter()
+            .enumerate()
+            .filter(|(_, &g)| local[g as usize] != u32::MAX)
+            .map(|(k, &g)| (k, local[g as usize] as usize))
+            .collect();
+        (constraints, loads, probes)
+    }
 }
 
 /// The layout a run asks for: `procs` from the deck or command line, `workers` threads or ranks.
@@ -93,63 +178,28 @@ pub fn build_cube<M: Model>(
     let bonds: BondList<M::Bond> =
         plan.find_bonds(&p.x0, setup.horizon, setup.spacing, setup.partial_volume);
 
-    // Global store index → local index, for owned particles.
+    // Global id → local index, for owned particles.
     let mut local = vec![u32::MAX; g.len()];
     for l in 0..plan.n_owned {
-        local[idx(l)] = l as u32;
+        local[g.gid[idx(l)] as usize] = l as u32;
     }
-    let owned = |list: &[u32]| -> Vec<(usize, u32)> {
-        list.iter()
-            .enumerate()
-            .filter(|(_, &gi)| local[gi as usize] != u32::MAX)
-            .map(|(k, &gi)| (k, local[gi as usize]))
-            .collect()
-    };
+    let everywhere = Everywhere::of(setup);
+    let (constraints, loads, probes) = everywhere.share(&local);
     let mut sim = Simulation::new(setup.sim.model.clone(), p, bonds, setup.sim.dt);
     sim.integrator = setup.sim.integrator;
-    sim.constraints = setup
-        .sim
-        .constraints
-        .iter()
-        .map(|c| {
-            Constraint::new(
-                &c.name,
-                owned(&c.particles).into_iter().map(|(_, l)| l).collect(),
-                c.dofs.clone(),
-                c.motion.clone(),
-                c.history.clone(),
-            )
-        })
-        .collect();
-    sim.loads = setup
-        .sim
-        .loads
-        .iter()
-        .map(|l| {
-            let mine = owned(&l.particles);
-            Load {
-                name: l.name.clone(),
-                particles: mine.iter().map(|&(_, i)| i).collect(),
-                weight: mine.iter().map(|&(k, _)| l.weight[k]).collect(),
-                vector: l.vector,
-                history: l.history.clone(),
-            }
-        })
-        .collect();
-    let probes = setup
-        .probes
-        .iter()
-        .enumerate()
-        .filter(|(_, (_, gi))| local[*gi] != u32::MAX)
-        .map(|(k, (_, gi))| (k, local[*gi] as usize))
-        .collect();
+    sim.constraints = constraints;
+    sim.loads = loads;
     let stages = plan.stages.clone();
     sim.exchange = Box::new(WallExchange::new(stages, transport));
     Cube {
+        lost: vec![0; plan.n_owned],
         sim,
         plan,
+        layout: layout.clone(),
         probes,
         global_particles: g.len(),
+        everywhere,
+        dropped: Vec::new(),
     }
 }
 
@@ -194,10 +244,15 @@ impl<M: Model> Cube<M> {
                 if b.initial[i] == 0 {
                     0.0
                 } else {
-                    broken[i] / b.initial[i] as f64
+                    (broken[i] + self.lost[i] as f64) / b.initial[i] as f64
                 }
             })
             .collect()
+    }
+
+    /// Broken bonds of this procCube, those dropped by shuffles included.
+    pub fn broken_count(&self) -> usize {
+        self.sim.bonds.broken_count() + self.dropped.len()
     }
 
     /// The broken bonds of this procCube as (smaller, larger) global id pairs.
@@ -207,6 +262,7 @@ impl<M: Model> Cube<M> {
         b.iter()
             .filter(|&(_, _, k)| b.broken[k])
             .map(|(i, j, _)| (gid[i].min(gid[j]), gid[i].max(gid[j])))
+            .chain(self.dropped.iter().copied())
             .collect()
     }
 }
@@ -282,7 +338,7 @@ impl<M: Model> Cube<M> {
         Team::new(self.sim.exchange.transport()).reduce(&mut v, Reduce::Max);
         let mut s = [
             self.sim.bonds.len() as f64,
-            self.sim.bonds.broken_count() as f64,
+            self.broken_count() as f64,
             (after.bytes - before.bytes) as f64 / steps.max(1) as f64,
         ];
         Team::new(self.sim.exchange.transport()).reduce(&mut s, Reduce::Sum);

@@ -28,6 +28,8 @@ pub struct Summary {
     pub seconds: f64,
     pub timing: String,
     pub layout: String,
+    /// Particle shuffles that moved particles between procCubes.
+    pub shuffles: u64,
     /// Final positions by global id, and the broken bonds as sorted global id pairs (when the
     /// deck asks for `final_state`, or for tests).
     pub positions: Vec<[f64; 3]>,
@@ -101,7 +103,7 @@ fn dof_name(d: usize) -> String {
 fn row<M: Model>(cube: &mut Cube<M>, damage: &[f64], n_probes: usize) -> Vec<f64> {
     let sim = &cube.sim;
     let (ke, se) = (sim.kinetic_energy(), sim.strain_energy());
-    let mut sums = vec![ke, se, sim.bonds.broken_count() as f64];
+    let mut sums = vec![ke, se, cube.broken_count() as f64];
     for l in &sim.loads {
         let t = l.total(sim.time);
         let norm = (l.vector[0].powi(2) + l.vector[1].powi(2) + l.vector[2].powi(2)).sqrt();
@@ -148,7 +150,7 @@ fn gather_frame<M: Model>(cube: &mut Cube<M>, damage: &[f64], store: &mut Option
     let n = cube.sim.particles.n_owned;
     let mut mine = Vec::with_capacity(n * (2 + <M::Alter as Attributes>::LEN));
     for (i, &d) in damage.iter().enumerate().take(n) {
-        mine.push(cube.plan.global[i] as f64);
+        mine.push(cube.sim.particles.gid[i] as f64);
         mine.push(d);
         mine.extend_from_slice(cube.sim.particles.alter[i].as_slice());
     }
@@ -157,7 +159,7 @@ fn gather_frame<M: Model>(cube: &mut Cube<M>, damage: &[f64], store: &mut Option
         let len = 2 + <M::Alter as Attributes>::LEN;
         for bytes in all {
             for rec in f64s(&bytes).chunks_exact(len) {
-                let g = rec[0] as usize;
+                let g = store.index_of[rec[0] as usize] as usize;
                 store.damage[g] = rec[1];
                 store.particles.alter[g]
                     .as_mut_slice()
@@ -171,6 +173,8 @@ fn gather_frame<M: Model>(cube: &mut Cube<M>, damage: &[f64], store: &mut Option
 struct FrameStore<M: Model> {
     particles: Particles<M>,
     damage: Vec<f64>,
+    /// Store index of each global id.
+    index_of: Vec<u32>,
 }
 
 /// What every worker needs to know about the run beyond its own procCube.
@@ -183,6 +187,7 @@ struct Plan {
     progress: bool,
     quiet: bool,
     final_state: bool,
+    shuffle_every: u64,
     n_probes: usize,
     layout: String,
 }
@@ -218,9 +223,18 @@ fn drive<M: Model>(
     let mut progress = Progress::new(plan.steps, root && plan.progress && !plan.quiet);
     let wall = Instant::now();
     let mut broken = 0usize;
+    let mut shuffles = 0u64;
     for step in 0..=plan.steps {
         if step > 0 {
             cube.sim.advance();
+            if plan.shuffle_every > 0 && step % plan.shuffle_every == 0 {
+                let t = Instant::now();
+                // Every worker sees the same scene here, so all fail alike.
+                if cube.shuffle()? {
+                    shuffles += 1;
+                }
+                cube.sim.timing.lap(Phase::Communication, t);
+            }
         }
         let last = step == plan.steps;
         let want_row = step % plan.every == 0 || last;
@@ -261,7 +275,7 @@ fn drive<M: Model>(
     let n_global = cube.global_particles;
     let mut totals = [
         cube.sim.bonds.len() as f64,
-        cube.sim.bonds.broken_count() as f64,
+        cube.broken_count() as f64,
         cube.sim.kinetic_energy(),
         cube.sim.strain_energy(),
     ];
@@ -339,6 +353,7 @@ fn drive<M: Model>(
         seconds,
         timing,
         layout: plan.layout.clone(),
+        shuffles,
         positions: position,
         broken_pairs,
     }))
@@ -444,6 +459,7 @@ fn run_setup<M: Model>(
         progress: scene.output.progress,
         quiet: opts.quiet,
         final_state: scene.output.final_state,
+        shuffle_every: scene.parallel.shuffle_every,
         n_probes: setup.probes.len(),
         layout: layout.describe(),
     };
@@ -502,9 +518,14 @@ fn run_setup<M: Model>(
 
 fn frame_store<M: Model>(setup: Setup<M>) -> FrameStore<M> {
     let n = setup.sim.particles.len();
+    let mut index_of = vec![0u32; n];
+    for (i, &g) in setup.sim.particles.gid.iter().enumerate() {
+        index_of[g as usize] = i as u32;
+    }
     FrameStore {
         particles: setup.sim.particles,
         damage: vec![0.0; n],
+        index_of,
     }
 }
 

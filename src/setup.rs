@@ -278,7 +278,10 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
 /// Cells of side ≥ the horizon over the scene. A periodic axis spans the lattice box (particle
 /// positions ± half a spacing) exactly, so that its cells tile one period.
 fn domain(points: &[[f64; 3]], scene: &Scene) -> Result<Domain, DeckError> {
-    let mut grid = CellGrid::covering(points, scene.horizon);
+    // With shuffling, bonds are found from current cells: the skin keeps a stretched bond
+    // between neighbouring cells.
+    let min_cell = scene.horizon * (1.0 + scene.parallel.skin);
+    let mut grid = CellGrid::covering(points, min_cell);
     let mut period = [0.0; 3];
     for a in 0..3 {
         if !scene.periodic[a] {
@@ -290,15 +293,16 @@ fn domain(points: &[[f64; 3]], scene: &Scene) -> Result<Domain, DeckError> {
             .map(|p| p[a])
             .fold(f64::NEG_INFINITY, f64::max);
         let length = hi - lo + scene.spacing;
-        let n = (length / (scene.horizon * (1.0 + 1e-9))).floor() as usize;
+        let n = (length / (min_cell * (1.0 + 1e-9))).floor() as usize;
         if n < 3 {
             return Err(scene.error(
                 None,
                 format!(
-                    "[lattice] periodic axis {} is {:.4e} long, less than three horizons ({:.4e}); make the body longer along it or drop the axis from 'periodic'",
+                    "[lattice] periodic axis {} is {:.4e} long, less than three horizons{} ({:.4e}); make the body longer along it or drop the axis from 'periodic'",
                     ["x", "y", "z"][a],
                     length,
-                    3.0 * scene.horizon
+                    if scene.parallel.skin > 0.0 { " with the shuffle skin" } else { "" },
+                    3.0 * min_cell
                 ),
             ));
         }

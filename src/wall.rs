@@ -116,6 +116,11 @@ impl WallExchange {
         }
     }
 
+    /// A new plan over the same transport (after a shuffle).
+    pub fn set_stages(&mut self, stages: Vec<Stage>) {
+        self.stages = stages;
+    }
+
     pub fn stages(&self) -> &[Stage] {
         &self.stages
     }

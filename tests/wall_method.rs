@@ -418,3 +418,68 @@ fn layouts_that_cannot_work_say_what_to_change() {
         "{e}"
     );
 }
+
+/// Two halves of a free block thrown along x at different speeds: the block travels several
+/// cells, so particles cross procCube faces, and it tears at the middle.
+fn flying_block(extra: &str) -> String {
+    format!(
+        r#"units = "SI"
+[model]
+name = "pmb"
+horizon = "3.015 mm"
+[lattice]
+spacing = "1 mm"
+[materials.rock]
+density = "2200 kg/m^3"
+bulk_modulus = "14.9 GPa"
+critical_stretch = 0.002
+[[geometry]]
+shape = "box"
+material = "rock"
+min = "0 0 0 mm"
+max = "20 8 8 mm"
+[time]
+steps = 400
+[[initial]]
+region = {{ shape = "box", min = "0 0 0 mm", max = "10 8 8 mm" }}
+velocity = "150 10 0 m/s"
+[[initial]]
+region = {{ shape = "box", min = "10 0 0 mm", max = "20 8 8 mm" }}
+velocity = "260 0 -5 m/s"
+[output]
+progress = false
+history_every = 50
+{extra}
+"#
+    )
+}
+
+#[test]
+fn shuffled_runs_match_unshuffled_ones() {
+    // Same cells (the skin) for both, so that only the shuffling differs.
+    let plain = flying_block("[parallel]\nskin = 0.25\n");
+    let reference = run_layout(&plain, [1, 1, 1], Walls::Whole);
+    assert!(reference.broken > 100, "{} broken", reference.broken);
+    let travel = reference
+        .positions
+        .iter()
+        .map(|p| p[0])
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        travel > 0.008,
+        "the block must travel several cells ({travel})"
+    );
+    for (procs, walls) in [([2, 1, 1], Walls::Whole), ([4, 1, 1], Walls::Trimmed)] {
+        let shuffled = flying_block("[parallel]\nshuffle_every = 20\n");
+        let s = run_layout(&shuffled, procs, walls);
+        assert!(s.shuffles > 0, "{procs:?}: no particle changed procCube");
+        let d = max_relative_difference(&reference.positions, &s.positions);
+        eprintln!(
+            "{procs:?} shuffled {} times: max relative position difference {d:.2e}",
+            s.shuffles
+        );
+        assert!(d <= 1e-12, "{procs:?}: positions differ by {d:e}");
+        assert_eq!(s.broken_pairs, reference.broken_pairs, "{procs:?}");
+        assert_eq!(s.broken, reference.broken);
+    }
+}
