@@ -6,6 +6,7 @@ fn main() {
         threads: vec![1],
         ranks: vec![],
         walls: pdq::decomposition::Walls::Whole,
+        procs: pdq::decomposition::Procs::Auto,
         yardstick: true,
         steps: 100,
         n: 40,

@@ -23,6 +23,7 @@ pub struct BenchOptions {
     /// MPI rank counts to time (each through `mpirun`), one line each.
     pub ranks: Vec<usize>,
     pub walls: Walls,
+    pub procs: Procs,
     /// Whether to time the yardstick (generic against hand-written PMB loop).
     pub yardstick: bool,
     pub steps: u64,
@@ -234,7 +235,7 @@ fn bench_setup<M: Model>(
     let mut out = String::new();
     let mut one_thread = None;
     for &threads in &opts.threads {
-        let layout = parallel::layout(&setup, &Procs::Auto, threads, opts.walls)?;
+        let layout = parallel::layout(&setup, &opts.procs, threads, opts.walls)?;
         let cubes = parallel::thread_cubes(&setup, &layout);
         let timed = parallel::on_threads(cubes, |c| c.timed_steps(opts.steps));
         let t = &timed[0];

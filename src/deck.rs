@@ -834,18 +834,19 @@ impl Converter {
                 )
             }
         };
-        let skin =
-            match p.skin {
-                None if shuffle_every > 0 => 0.25,
-                None => 0.0,
-                Some(s) if s.is_finite() && (0.0..=10.0).contains(&s) => s,
-                Some(s) => return self.err(
+        let skin = match p.skin {
+            None if shuffle_every > 0 => 0.25,
+            None => 0.0,
+            Some(s) if s.is_finite() && (0.0..=10.0).contains(&s) => s,
+            Some(s) => {
+                return self.err(
                     line,
                     format!(
                         "[parallel] skin = {s}: give a fraction of the horizon between 0 and 10"
                     ),
-                ),
-            };
+                )
+            }
+        };
         Ok(ParallelSpec {
             line,
             procs,

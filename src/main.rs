@@ -57,6 +57,9 @@ enum Cmd {
         /// Ghost messages: whole walls or trimmed.
         #[arg(long, value_parser = parse_walls, default_value = "whole")]
         walls: pdq::decomposition::Walls,
+        /// ProcCubes as NXxNYxNZ for every thread count (default: chosen per count).
+        #[arg(long, value_parser = parse_procs)]
+        procs: Option<pdq::decomposition::Procs>,
         /// Skip the generic-against-hand-written force pass comparison.
         #[arg(long)]
         no_yardstick: bool,
@@ -117,6 +120,7 @@ fn main() -> ExitCode {
             threads,
             ranks,
             walls,
+            procs,
             no_yardstick,
             steps,
             n,
@@ -127,6 +131,7 @@ fn main() -> ExitCode {
             threads,
             ranks,
             walls,
+            procs: procs.unwrap_or(pdq::decomposition::Procs::Auto),
             yardstick: !no_yardstick,
             steps,
             n,
