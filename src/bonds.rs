@@ -33,6 +33,63 @@ pub fn partial_volume(l: f64, horizon: f64, dx: f64) -> f64 {
     }
 }
 
+/// A bond list built one owner at a time, in owner order.
+pub(crate) struct Families {
+    offsets: Vec<u32>,
+    partner: Vec<u32>,
+    geom: Vec<BondGeom>,
+    initial: Vec<u32>,
+    horizon: f64,
+    dx: f64,
+    partial: bool,
+}
+
+impl Families {
+    /// For a store of `n` particles (owned and ghosts).
+    pub(crate) fn new(n: usize, horizon: f64, dx: f64, partial: bool) -> Families {
+        Families {
+            offsets: vec![0],
+            partner: Vec::new(),
+            geom: Vec::new(),
+            initial: vec![0; n],
+            horizon,
+            dx,
+            partial,
+        }
+    }
+
+    /// Stores the family of the next owner `i`: `found` holds (partner, length) pairs; they are
+    /// stored in partner order, so the result does not depend on the search order.
+    pub(crate) fn close(&mut self, i: usize, found: &mut [(u32, f64)]) {
+        assert_eq!(
+            i + 1,
+            self.offsets.len(),
+            "families must be closed in owner order"
+        );
+        found.sort_unstable_by_key(|&(j, _)| j);
+        for &(j, l) in found.iter() {
+            self.partner.push(j);
+            let beta = if self.partial {
+                partial_volume(l, self.horizon, self.dx)
+            } else {
+                1.0
+            };
+            self.geom.push(BondGeom { length: l, beta });
+            self.initial[i] += 1;
+            self.initial[j as usize] += 1;
+        }
+        assert!(
+            self.partner.len() < u32::MAX as usize,
+            "too many bonds for u32 offsets"
+        );
+        self.offsets.push(self.partner.len() as u32);
+    }
+
+    pub(crate) fn finish<H: Attributes>(self) -> BondList<H> {
+        BondList::assemble(self.offsets, self.partner, self.geom, self.initial)
+    }
+}
+
 impl<H: Attributes> BondList<H> {
     /// Every pair (i, j) with |x_j − x_i| ≤ `horizon` where i is owned (`i < n_owned`).
     /// Pairs of two ghosts are not bonds here. `dx` is the lattice spacing for partial volumes
@@ -53,11 +110,7 @@ impl<H: Attributes> BondList<H> {
         // A pair at exactly the horizon (m = 3 on a lattice) is in the family whatever the
         // rounding of its coordinates: the test allows a relative 1e-10.
         let h2 = horizon * horizon * (1.0 + 2e-10);
-        let mut offsets = Vec::with_capacity(n_owned + 1);
-        let mut partner = Vec::new();
-        let mut geom = Vec::new();
-        let mut initial = vec![0u32; x0.len()];
-        offsets.push(0u32);
+        let mut families = Families::new(x0.len(), horizon, dx, partial);
         let mut found: Vec<(u32, f64)> = Vec::new();
         for i in 0..n_owned {
             let xi = x0[i];
@@ -104,34 +157,9 @@ impl<H: Attributes> BondList<H> {
             }
             // Ghost partners in the own cell with a lower index cannot exist (ghosts come after
             // owned particles), and forward cells were scanned in full above.
-            found.sort_unstable_by_key(|&(j, _)| j);
-            for &(j, l) in &found {
-                partner.push(j);
-                let beta = if partial {
-                    partial_volume(l, horizon, dx)
-                } else {
-                    1.0
-                };
-                geom.push(BondGeom { length: l, beta });
-                initial[i] += 1;
-                initial[j as usize] += 1;
-            }
-            assert!(
-                partner.len() < u32::MAX as usize,
-                "too many bonds for u32 offsets"
-            );
-            offsets.push(partner.len() as u32);
+            families.close(i, &mut found);
         }
-        let n = partner.len();
-        BondList {
-            offsets,
-            max_partner: partner.iter().map(|&j| j as usize).max().unwrap_or(0),
-            partner,
-            geom,
-            broken: vec![false; n],
-            history: vec![H::default(); n],
-            initial,
-        }
+        families.finish()
     }
 
     /// A bond list from bonds already found elsewhere (the wall method's per-procCube search):

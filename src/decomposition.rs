@@ -9,9 +9,8 @@
 //! history) on that side. The plan is computed from cells alone, identically on every worker,
 //! so sender and receiver agree on every message without negotiating.
 
-use crate::bonds::{partial_volume, BondList};
+use crate::bonds::{BondList, Families};
 use crate::cells::{CellGrid, HALF_SHELL};
-use crate::model::BondGeom;
 use std::ops::Range;
 
 /// The five ghost messages in order, as (axis, direction): east, west, north, up, down.
@@ -642,12 +641,7 @@ impl CubePlan {
             at_slot[s] = Some(k);
         }
         let h2 = horizon * horizon * (1.0 + 2e-10);
-        let n = x0.len();
-        let mut offsets = Vec::with_capacity(self.n_owned + 1);
-        let mut partner = Vec::new();
-        let mut geom = Vec::new();
-        let mut initial = vec![0u32; n];
-        offsets.push(0u32);
+        let mut families = Families::new(x0.len(), horizon, dx, partial);
         let mut found: Vec<(u32, f64)> = Vec::new();
         for k in 0..c.owned_cells {
             let at = c.held[k].at;
@@ -683,26 +677,10 @@ impl CubePlan {
                         visit(j);
                     }
                 }
-                found.sort_unstable_by_key(|&(j, _)| j);
-                for &(j, l) in &found {
-                    partner.push(j);
-                    let beta = if partial {
-                        partial_volume(l, horizon, dx)
-                    } else {
-                        1.0
-                    };
-                    geom.push(BondGeom { length: l, beta });
-                    initial[i] += 1;
-                    initial[j as usize] += 1;
-                }
-                assert!(
-                    partner.len() < u32::MAX as usize,
-                    "too many bonds for u32 offsets"
-                );
-                offsets.push(partner.len() as u32);
+                families.close(i, &mut found);
             }
         }
-        BondList::assemble(offsets, partner, geom, initial)
+        families.finish()
     }
 
     /// Ghost particles this procCube holds.

@@ -9,6 +9,9 @@ use pdq::run::{run, RunOptions};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+use common::max_relative_difference;
+
 const DECK: &str = "tests/decks/notched_pull.toml";
 
 fn out_dir(name: &str) -> PathBuf {
@@ -59,16 +62,6 @@ fn mpirun(np: usize, extra: &[&str], dir: &Path) {
     );
 }
 
-fn relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let scale = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-    a.iter()
-        .zip(b)
-        .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))
-        .fold(0.0, f64::max)
-        / scale
-}
-
 #[test]
 fn mpi_ranks_agree_with_threads() {
     let scene = deck::load(Path::new(DECK)).unwrap();
@@ -102,7 +95,7 @@ fn mpi_ranks_agree_with_threads() {
         String::from_utf8_lossy(&out.stderr)
     );
     let (pos, broken) = read_final(&solo);
-    assert!(relative_difference(&ref_pos, &pos) <= 1e-12);
+    assert!(max_relative_difference(&ref_pos, &pos) <= 1e-12);
     assert_eq!(broken, ref_broken, "one rank without mpirun");
 
     for (np, extra) in [
@@ -113,7 +106,7 @@ fn mpi_ranks_agree_with_threads() {
         let dir = out_dir(&format!("np{np}-{}", extra.len()));
         mpirun(np, &extra, &dir);
         let (pos, broken) = read_final(&dir);
-        let d = relative_difference(&ref_pos, &pos);
+        let d = max_relative_difference(&ref_pos, &pos);
         eprintln!("mpirun -np {np} {extra:?}: max relative position difference {d:.2e}");
         assert!(d <= 1e-12, "-np {np}: positions differ by {d:e}");
         assert_eq!(

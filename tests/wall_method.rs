@@ -9,6 +9,9 @@ use pdq::parallel;
 use pdq::run::{run, RunOptions, Summary};
 use pdq::setup::build_as;
 use proptest::prelude::*;
+
+mod common;
+use common::max_relative_difference;
 use std::collections::BTreeMap;
 
 /// A PMB box of `n` particles per axis at unit spacing with horizon `h`, periodic on `periodic`.
@@ -191,19 +194,6 @@ fn run_layout(text: &str, procs: [usize; 3], walls: Walls) -> Summary {
     .unwrap();
     let _ = std::fs::remove_dir_all(dir);
     s
-}
-
-fn max_relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let scale = a
-        .iter()
-        .flat_map(|x| x.iter())
-        .fold(0.0f64, |m, v| m.max(v.abs()));
-    a.iter()
-        .zip(b)
-        .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))
-        .fold(0.0, f64::max)
-        / scale
 }
 
 #[test]

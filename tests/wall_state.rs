@@ -9,6 +9,9 @@ use pdq::model::{check_options, stretch, BondGeom, Model, ModelBuild, Side};
 use pdq::models::pmb::{Force3, Motion};
 use pdq::{deck, parallel, setup};
 
+mod common;
+use common::max_relative_difference;
+
 pdq::attributes! {
     /// Volume-weighted sum of bond stretches around a particle.
     pub struct Dilatation { pub theta: f64 }
@@ -160,10 +163,6 @@ fn state_passes_give_the_same_results_on_every_layout() {
     assert_eq!(<Dilatation as Attributes>::LEN, 1);
     let (reference, broken) = run([1, 1, 1], Walls::Whole, 300);
     assert!(!broken.is_empty(), "the block must tear");
-    let scale = reference
-        .iter()
-        .flatten()
-        .fold(0.0f64, |m, v| m.max(v.abs()));
     for (procs, walls) in [
         ([2, 1, 1], Walls::Whole),
         ([2, 2, 2], Walls::Whole),
@@ -171,12 +170,7 @@ fn state_passes_give_the_same_results_on_every_layout() {
         ([1, 3, 2], Walls::Trimmed),
     ] {
         let (pos, b) = run(procs, walls, 300);
-        let d = reference
-            .iter()
-            .zip(&pos)
-            .flat_map(|(a, c)| (0..3).map(move |k| (a[k] - c[k]).abs()))
-            .fold(0.0, f64::max)
-            / scale;
+        let d = max_relative_difference(&reference, &pos);
         assert!(d <= 1e-12, "{procs:?}: positions differ by {d:e}");
         assert_eq!(b, broken, "{procs:?}: broken bonds differ");
     }
