@@ -7,6 +7,7 @@ fn main() {
         ranks: vec![],
         walls: pdq::decomposition::Walls::Whole,
         procs: pdq::decomposition::Procs::Auto,
+        rounds: 1,
         yardstick: true,
         steps: 100,
         n: 40,

@@ -32,6 +32,8 @@ pub struct BenchOptions {
     pub peer: bool,
     /// Repetitions of the yardstick comparison (medians are reported).
     pub repeat: usize,
+    /// Times through the thread counts (medians are reported when more than one).
+    pub rounds: usize,
 }
 
 const SPACING: f64 = 0.001;
@@ -233,20 +235,28 @@ fn bench_setup<M: Model>(
 ) -> Result<(String, f64), String> {
     let n = setup.sim.particles.n_owned;
     let mut out = String::new();
-    let mut one_thread = None;
-    for &threads in &opts.threads {
+    // Runs alternate through the thread counts `rounds` times; each speed-up is taken against
+    // the one-thread run just before it, so a slow spell of a shared machine hits both.
+    let mut last_one = None;
+    let mut per_count: std::collections::BTreeMap<usize, (Vec<f64>, Vec<f64>)> = Default::default();
+    let rounds = opts.rounds.max(1);
+    let order: Vec<usize> = (0..rounds)
+        .flat_map(|_| opts.threads.iter().copied())
+        .collect();
+    for &threads in &order {
         let layout = parallel::layout(&setup, &opts.procs, threads, opts.walls)?;
         let cubes = parallel::thread_cubes(&setup, &layout);
         let timed = parallel::on_threads(cubes, |c| c.timed_steps(opts.steps));
         let t = &timed[0];
         let us = 1e6 * t.seconds / (n as f64 * opts.steps as f64);
         let _ = write!(out, "{}", line(M::NAME, n, opts.steps, threads, 1, t));
-        match one_thread {
-            None if threads == 1 => one_thread = Some(us),
-            Some(base) => {
-                let _ = write!(out, " speedup={:.2}", base / us);
-            }
-            None => {}
+        let entry = per_count.entry(threads).or_default();
+        entry.0.push(us);
+        if threads == 1 {
+            last_one = Some(us);
+        } else if let Some(base) = last_one {
+            let _ = write!(out, " speedup={:.2}", base / us);
+            entry.1.push(base / us);
         }
         let _ = writeln!(out, " layout={}", layout.describe().replace(' ', "_"));
         if timed.len() > 1 {
@@ -265,7 +275,25 @@ fn bench_setup<M: Model>(
             let _ = writeln!(out, "# {l}");
         }
     }
-    let ours = one_thread.unwrap_or(f64::NAN);
+    if rounds > 1 {
+        for (threads, (us, speedups)) in &per_count {
+            let _ = write!(
+                out,
+                "bench median model={} threads={threads} runs={} us_per_particle_step={:.4}",
+                M::NAME,
+                us.len(),
+                median(us.clone())
+            );
+            if !speedups.is_empty() {
+                let _ = write!(out, " speedup={:.2}", median(speedups.clone()));
+            }
+            let _ = writeln!(out);
+        }
+    }
+    let ours = per_count
+        .get(&1)
+        .map(|(us, _)| median(us.clone()))
+        .unwrap_or(f64::NAN);
     if !opts.yardstick {
         return Ok((out, ours));
     }

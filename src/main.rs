@@ -74,6 +74,9 @@ enum Cmd {
         /// Repetitions of the generic-vs-hand force pass comparison.
         #[arg(long, default_value_t = 7)]
         repeat: usize,
+        /// Times through the thread counts, alternating; medians are printed when above 1.
+        #[arg(long, default_value_t = 1)]
+        rounds: usize,
     },
 }
 
@@ -126,6 +129,7 @@ fn main() -> ExitCode {
             n,
             peer,
             repeat,
+            rounds,
         } => bench::run(&bench::BenchOptions {
             model,
             threads,
@@ -137,6 +141,7 @@ fn main() -> ExitCode {
             n,
             peer,
             repeat,
+            rounds,
         })
         .map(|s| print!("{s}")),
     };

@@ -53,6 +53,7 @@ impl WallExchange {
         }
         for (s, st) in self.stages.iter().enumerate() {
             self.out.clear();
+            self.out.reserve(st.send.len() * size);
             for &i in &st.send {
                 self.out
                     .extend_from_slice(bytemuck::bytes_of(&data[i as usize]));
@@ -71,16 +72,16 @@ impl WallExchange {
                 st.recv.len() * size,
                 "ghost message of stage {s} has the wrong size"
             );
-            let moved = shift && st.shift != [0.0; 3];
-            for (k, i) in st.recv.clone().enumerate() {
-                let mut v: T = bytemuck::pod_read_unaligned(&self.inp[k * size..(k + 1) * size]);
-                if moved {
-                    let f: &mut [f64] = bytemuck::cast_slice_mut(std::slice::from_mut(&mut v));
+            // Received ghosts are one contiguous run of the store: one copy.
+            let ghosts = &mut data[st.recv.clone()];
+            bytemuck::cast_slice_mut::<T, u8>(ghosts).copy_from_slice(&self.inp);
+            if shift && st.shift != [0.0; 3] {
+                for v in ghosts.iter_mut() {
+                    let f: &mut [f64] = bytemuck::cast_slice_mut(std::slice::from_mut(v));
                     for (x, d) in f.iter_mut().zip(st.shift) {
                         *x += d;
                     }
                 }
-                data[i] = v;
             }
         }
     }
