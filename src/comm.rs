@@ -107,6 +107,9 @@ pub struct Threads {
     give_back: Vec<Sender<Vec<u8>>>,
     /// Buffers coming back from the workers this worker sent to.
     returned: Vec<Receiver<Vec<u8>>>,
+    /// How long to spin for a message before parking: only when every worker has a core, as a
+    /// spinning thread would otherwise take the core from the one it waits for.
+    spin: std::time::Duration,
 }
 
 impl Threads {
@@ -132,8 +135,15 @@ impl Threads {
             back_tx.push(bt);
             back_rx.push(br);
         }
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        let spin = if n <= cores {
+            std::time::Duration::from_micros(200)
+        } else {
+            std::time::Duration::ZERO
+        };
         (0..n)
             .map(|me| Threads {
+                spin,
                 rank: me,
                 size: n,
                 to: (0..n).map(|r| data_tx[me][r].take().unwrap()).collect(),
@@ -178,7 +188,7 @@ impl Transport for Threads {
             // avoids parking the thread and paying the wake-up on almost every message.
             let mut got = None;
             let start = std::time::Instant::now();
-            while start.elapsed() < std::time::Duration::from_micros(200) {
+            while start.elapsed() < self.spin {
                 match self.from[f].try_recv() {
                     Ok(m) => {
                         got = Some(m);
