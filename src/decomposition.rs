@@ -29,7 +29,7 @@ pub enum Procs {
 /// What a ghost message carries.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Walls {
-    /// Whole walls, as the thesis sends them.
+    /// Every cell the sender holds in its face layer (received ones included), as the thesis sends.
     #[default]
     Whole,
     /// Only the cells the receiver uses or passes on (the thesis's beams, columns and cornices).
