@@ -274,7 +274,7 @@ fn drive<M: Model>(
     // Totals, the final state, and where each procCube's time went.
     let n_global = cube.global_particles;
     let mut totals = [
-        cube.sim.bonds.len() as f64,
+        (cube.sim.bonds.len() + cube.dropped.len()) as f64,
         cube.broken_count() as f64,
         cube.sim.kinetic_energy(),
         cube.sim.strain_energy(),
@@ -331,6 +331,18 @@ fn drive<M: Model>(
         .map(|b| f64s(b))
         .collect();
     let mut timing = cube.sim.timing.table(n_global as f64 * plan.steps as f64);
+    let _ = writeln!(
+        timing,
+        "bonds: {} ({} broken); {}{}",
+        totals[0] as usize,
+        totals[1] as usize,
+        plan.layout,
+        if shuffles > 0 {
+            format!(", {shuffles} shuffles moved particles")
+        } else {
+            String::new()
+        }
+    );
     if balance.len() > 1 {
         timing.push_str(&balance_table(&balance, plan.steps));
     }
@@ -603,6 +615,12 @@ fn describe<M: Model>(setup: &Setup<M>, scene: &Scene) -> String {
         scene.horizon / scene.spacing,
         scene.spacing
     );
+    if scene.periodic.iter().any(|&p| p) {
+        let _ = writeln!(
+            s,
+            "           (not counting bonds across periodic faces: the procCubes add those; the run's total is in timing.txt)"
+        );
+    }
     let _ = writeln!(
         s,
         "memory     {:.1} MiB (particles and bonds)",
