@@ -51,7 +51,8 @@ enum Cmd {
         /// Thread counts to time, comma-separated (one procCube per thread).
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
         threads: Vec<usize>,
-        /// MPI rank counts to time through mpirun, comma-separated (needs the `mpi` feature).
+        /// MPI rank counts to time through mpirun, comma-separated (needs the `mpi` feature;
+        /// default 1,2 in an MPI build, none otherwise).
         #[arg(long, value_delimiter = ',')]
         ranks: Vec<usize>,
         /// Ghost messages: whole walls or trimmed.
@@ -133,7 +134,11 @@ fn main() -> ExitCode {
         } => bench::run(&bench::BenchOptions {
             model,
             threads,
-            ranks,
+            ranks: if ranks.is_empty() && cfg!(feature = "mpi") && !launched_by_mpirun() {
+                vec![1, 2]
+            } else {
+                ranks
+            },
             walls,
             procs: procs.unwrap_or(pdq::decomposition::Procs::Auto),
             yardstick: !no_yardstick,
@@ -152,6 +157,14 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Whether this process is an MPI rank started by mpirun (always false without the feature).
+fn launched_by_mpirun() -> bool {
+    #[cfg(feature = "mpi")]
+    return pdq::comm_mpi::launched_by_mpirun();
+    #[cfg(not(feature = "mpi"))]
+    false
 }
 
 fn parse_procs(s: &str) -> Result<pdq::decomposition::Procs, String> {
