@@ -71,13 +71,15 @@ pub struct Layout {
 
 impl Domain {
     /// The same box with the cell count along each axis rounded down to a multiple of
-    /// `procs`, where that leaves at least one cell per procCube.
+    /// `procs`, where that leaves at least one cell per procCube (and, on a periodic axis, at
+    /// least three cells, so that a cell's two neighbours along it are different cells).
     pub fn for_procs(&self, procs: [usize; 3]) -> Domain {
         let mut d = self.clone();
         for (a, &p) in procs.iter().enumerate() {
             let n = self.grid.dims[a];
             let m = n - n % p.max(1);
-            if m >= p && m != n {
+            let least = if self.periodic[a] { p.max(3) } else { p };
+            if m >= least && m != n {
                 d.grid.size[a] = self.grid.size[a] * n as f64 / m as f64;
                 d.grid.dims[a] = m;
             }
@@ -151,7 +153,7 @@ impl Layout {
             }
             if procs[a] > g.dims[a] {
                 return Err(format!(
-                    "procs = {procs:?}: {} procCubes along {} but the scene is only {} cell{} wide there (cells are at least one horizon, {:.4e}, so a procCube is never thinner than the horizon); use at most {} procCube{} along {}, or a smaller horizon",
+                    "procs = {procs:?}: {} procCubes along {} but the scene is only {} cell{} wide there (its cells are {:.4e} wide, at least one horizon, so a procCube is never thinner than the horizon); use at most {} procCube{} along {}, or a smaller horizon",
                     procs[a],
                     AXES[a],
                     g.dims[a],

@@ -33,6 +33,8 @@ pub struct Summary {
     /// Final positions by global id, and the broken bonds as sorted global id pairs (when the
     /// deck asks for `final_state`, or for tests).
     pub positions: Vec<[f64; 3]>,
+    /// Final damage by global id.
+    pub damage: Vec<f64>,
     pub broken_pairs: Vec<(u32, u32)>,
 }
 
@@ -147,23 +149,32 @@ fn any_failed<M: Model>(cube: &mut Cube<M>, failed: bool) -> bool {
 
 /// Owned particles' global indices, alterable records and damage, gathered on the root.
 fn gather_frame<M: Model>(cube: &mut Cube<M>, damage: &[f64], store: &mut Option<FrameStore<M>>) {
-    let n = cube.sim.particles.n_owned;
-    let mut mine = Vec::with_capacity(n * (2 + <M::Alter as Attributes>::LEN));
+    // Reference positions travel too: a shuffle moves them with particles it wraps around a
+    // periodic box.
+    let (la, lf) = (<M::Alter as Attributes>::LEN, <M::Force as Attributes>::LEN);
+    let p = &cube.sim.particles;
+    let n = p.n_owned;
+    let mut mine = Vec::with_capacity(n * (5 + la + lf));
     for (i, &d) in damage.iter().enumerate().take(n) {
-        mine.push(cube.sim.particles.gid[i] as f64);
+        mine.push(p.gid[i] as f64);
         mine.push(d);
-        mine.extend_from_slice(cube.sim.particles.alter[i].as_slice());
+        mine.extend_from_slice(&p.x0[i]);
+        mine.extend_from_slice(p.alter[i].as_slice());
+        mine.extend_from_slice(p.force[i].as_slice());
     }
     let all = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&mine));
     if let (Some(all), Some(store)) = (all, store.as_mut()) {
-        let len = 2 + <M::Alter as Attributes>::LEN;
         for bytes in all {
-            for rec in f64s(&bytes).chunks_exact(len) {
+            for rec in f64s(&bytes).chunks_exact(5 + la + lf) {
                 let g = store.index_of[rec[0] as usize] as usize;
                 store.damage[g] = rec[1];
+                store.particles.x0[g] = [rec[2], rec[3], rec[4]];
                 store.particles.alter[g]
                     .as_mut_slice()
-                    .copy_from_slice(&rec[2..]);
+                    .copy_from_slice(&rec[5..5 + la]);
+                store.particles.force[g]
+                    .as_mut_slice()
+                    .copy_from_slice(&rec[5 + la..]);
             }
         }
     }
@@ -280,10 +291,12 @@ fn drive<M: Model>(
         cube.sim.strain_energy(),
     ];
     Team::new(cube.sim.exchange.transport()).reduce(&mut totals, Reduce::Sum);
+    let damage = cube.damage();
     let mut mine: Vec<f64> = Vec::new();
-    for i in 0..cube.sim.particles.n_owned {
+    for (i, d) in damage.iter().enumerate() {
         mine.push(cube.sim.particles.gid[i] as f64);
         mine.extend_from_slice(&cube.sim.particles.pos(i));
+        mine.push(*d);
     }
     let positions = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&mine));
     let pairs: Vec<f64> = cube
@@ -309,9 +322,11 @@ fn drive<M: Model>(
         return Ok(None);
     }
     let mut position = vec![[f64::NAN; 3]; n_global];
+    let mut damage_by_id = vec![f64::NAN; n_global];
     for bytes in positions.unwrap_or_default() {
-        for rec in f64s(&bytes).chunks_exact(4) {
+        for rec in f64s(&bytes).chunks_exact(5) {
             position[rec[0] as usize] = [rec[1], rec[2], rec[3]];
+            damage_by_id[rec[0] as usize] = rec[4];
         }
     }
     let mut broken_pairs: Vec<(u32, u32)> = pairs
@@ -351,7 +366,7 @@ fn drive<M: Model>(
     }
     std::fs::write(dir.join("timing.txt"), &timing).map_err(io)?;
     if plan.final_state {
-        write_final_state(dir, &position, &broken_pairs).map_err(io)?;
+        write_final_state(dir, &position, &damage_by_id, &broken_pairs).map_err(io)?;
     }
     Ok(Some(Summary {
         particles: n_global,
@@ -367,6 +382,7 @@ fn drive<M: Model>(
         layout: plan.layout.clone(),
         shuffles,
         positions: position,
+        damage: damage_by_id,
         broken_pairs,
     }))
 }
@@ -375,13 +391,18 @@ fn drive<M: Model>(
 fn write_final_state(
     dir: &std::path::Path,
     position: &[[f64; 3]],
+    damage: &[f64],
     broken: &[(u32, u32)],
 ) -> std::io::Result<()> {
     use std::io::Write;
     let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("final_positions.csv"))?);
-    writeln!(f, "id,x,y,z")?;
-    for (g, p) in position.iter().enumerate() {
-        writeln!(f, "{g},{:.17e},{:.17e},{:.17e}", p[0], p[1], p[2])?;
+    writeln!(f, "id,x,y,z,damage")?;
+    for (g, (p, d)) in position.iter().zip(damage).enumerate() {
+        writeln!(
+            f,
+            "{g},{:.17e},{:.17e},{:.17e},{:.17e}",
+            p[0], p[1], p[2], d
+        )?;
     }
     f.flush()?;
     let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("broken_bonds.csv"))?);

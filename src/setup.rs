@@ -298,7 +298,7 @@ fn domain(points: &[[f64; 3]], scene: &Scene) -> Result<Domain, DeckError> {
             return Err(scene.error(
                 None,
                 format!(
-                    "[lattice] periodic axis {} is {:.4e} long, less than three horizons{} ({:.4e}); make the body longer along it or drop the axis from 'periodic'",
+                    "[lattice] periodic axis {} is {:.4e} long; it must be longer than three horizons{} ({:.4e}) to hold three cells; make the body longer along it or drop the axis from 'periodic'",
                     ["x", "y", "z"][a],
                     length,
                     if scene.parallel.skin > 0.0 { " with the shuffle skin" } else { "" },

@@ -114,7 +114,8 @@ impl<M: Model> Cube<M> {
                 volume[g] = r[4];
                 material[g] = r[5] as u16;
                 initial[g] = r[6] as u32;
-                lost[g] = r[7] as u32;
+                // Broken bonds from records read earlier may already have counted here.
+                lost[g] += r[7] as u32;
                 alter[g]
                     .as_mut_slice()
                     .copy_from_slice(&r[PARTICLE_HEAD..PARTICLE_HEAD + la]);
@@ -246,11 +247,11 @@ impl<M: Model> Cube<M> {
             let cell = held
                 .get(&target)
                 .map(|&k| plan.cell_range[k].clone())
-                .ok_or_else(|| format!("shuffle: no cell at {target:?} holds particle {j}"))?;
+                .unwrap_or_else(|| panic!("shuffle: no held cell at {target:?} for particle {j}"));
             let lj = plan.global[cell.clone()]
                 .binary_search(&j)
                 .map(|p| (cell.start + p) as u32)
-                .map_err(|_| format!("shuffle: particle {j} is not in its cell"))?;
+                .unwrap_or_else(|_| panic!("shuffle: particle {j} is not in its cell"));
             mine.push((li, lj, geom, h));
         }
         mine.sort_unstable_by_key(|&(i, j, _, _)| (i, j));
@@ -285,7 +286,12 @@ impl<M: Model> Cube<M> {
         for l in 0..plan.n_owned {
             local[g(l)] = l as u32;
         }
-        let (constraints, loads, probes) = self.everywhere.share(&local);
+        let (mut constraints, loads, probes) = self.everywhere.share(&local);
+        // Reactions are reported before the next force evaluation: each procCube keeps its
+        // share (the sum over procCubes is what the history shows).
+        for (new, old) in constraints.iter_mut().zip(&self.sim.constraints) {
+            new.reaction.clone_from(&old.reaction);
+        }
         self.sim.particles = part;
         self.sim.bonds = list;
         self.sim.constraints = constraints;

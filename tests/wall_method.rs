@@ -169,6 +169,15 @@ fn fracture_deck(extra: &str) -> String {
 }
 
 fn run_layout(text: &str, procs: [usize; 3], walls: Walls) -> Summary {
+    run_with_history(text, procs, walls).0
+}
+
+/// A run and its `history.csv` as rows of numbers (with the header).
+fn run_with_history(
+    text: &str,
+    procs: [usize; 3],
+    walls: Walls,
+) -> (Summary, Vec<String>, Vec<Vec<f64>>) {
     let scene = deck::parse(text, "t.toml", "t").unwrap();
     static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!(
@@ -192,8 +201,14 @@ fn run_layout(text: &str, procs: [usize; 3], walls: Walls) -> Summary {
         },
     )
     .unwrap();
+    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
     let _ = std::fs::remove_dir_all(dir);
-    s
+    (s, header, rows)
 }
 
 #[test]
@@ -471,5 +486,131 @@ fn shuffled_runs_match_unshuffled_ones() {
         assert!(d <= 1e-12, "{procs:?}: positions differ by {d:e}");
         assert_eq!(s.broken_pairs, reference.broken_pairs, "{procs:?}");
         assert_eq!(s.broken, reference.broken);
+        // Damage counts bonds a shuffle dropped once broken.
+        assert_eq!(s.damage, reference.damage, "{procs:?}: damage");
+    }
+}
+
+#[test]
+fn shuffles_keep_reactions_loads_and_damage() {
+    // A notched bar carried along x at 80 m/s by two grips that pull it apart at 4 m/s, with a
+    // total-force load and a probe: particles cross procCube faces, the grips keep reacting,
+    // and the history must not notice the shuffles.
+    let deck = |parallel: &str| {
+        format!(
+            r#"units = "SI"
+[model]
+name = "pmb"
+horizon = "3.015 mm"
+[lattice]
+spacing = "1 mm"
+[materials.rock]
+density = "2200 kg/m^3"
+bulk_modulus = "14.9 GPa"
+critical_stretch = 0.0005
+[[geometry]]
+shape = "box"
+material = "rock"
+min = "0 0 0 mm"
+max = "30 10 10 mm"
+[[geometry]]
+op = "subtract"
+shape = "box"
+min = "14.5 0 5 mm"
+max = "15.5 10 10 mm"
+[time]
+steps = 500
+[[initial]]
+region = {{ shape = "box", min = "0 0 0 mm", max = "30 10 10 mm" }}
+velocity = "80 0 0 m/s"
+[[boundary]]
+name = "left"
+region = {{ shape = "slab", axis = "x", from = "0 mm", to = "3 mm" }}
+velocity = "80 0 0 m/s"
+[[boundary]]
+name = "right"
+region = {{ shape = "slab", axis = "x", from = "27 mm", to = "30 mm" }}
+velocity = "80.2 0.05 0 m/s"
+components = ["x", "y"]
+[[load]]
+name = "push"
+region = {{ shape = "slab", axis = "z", from = "9 mm", to = "10 mm" }}
+total_force = "0 0 -50 N"
+[[probe]]
+name = "tip"
+at = "30 5 5 mm"
+[output]
+progress = false
+history_every = 50
+[parallel]
+{parallel}
+"#
+        )
+    };
+    let plain = deck("skin = 0.25");
+    let shuffled = deck("shuffle_every = 5");
+    let (a, header, rows_a) = run_with_history(&plain, [1, 1, 1], Walls::Whole);
+    let (b, _, rows_b) = run_with_history(&shuffled, [2, 2, 1], Walls::Whole);
+    assert!(
+        b.shuffles > 0,
+        "the grips must carry particles across a face"
+    );
+    let right = header.iter().position(|h| h == "reaction_right_x").unwrap();
+    assert!(
+        rows_a.iter().skip(1).all(|r| r[right].abs() > 0.1),
+        "the right grip must pull on the bar all along"
+    );
+    assert_eq!(a.broken_pairs, b.broken_pairs);
+    assert!(max_relative_difference(&a.positions, &b.positions) <= 1e-12);
+    for (k, d) in a.damage.iter().zip(&b.damage).enumerate() {
+        assert!(
+            (d.0 - d.1).abs() <= 1e-12,
+            "particle {k}: damage {} vs {}",
+            d.0,
+            d.1
+        );
+    }
+    assert_eq!(rows_a.len(), rows_b.len());
+    for (ra, rb) in rows_a.iter().zip(&rows_b) {
+        for (c, name) in header.iter().enumerate() {
+            let scale = rows_a.iter().map(|r| r[c].abs()).fold(1e-30, f64::max);
+            assert!(
+                (ra[c] - rb[c]).abs() <= 1e-9 * scale + 1e-12,
+                "step {}: {name} {} vs {}",
+                ra[0],
+                ra[c],
+                rb[c]
+            );
+        }
+    }
+}
+
+#[test]
+fn shuffling_on_a_short_periodic_axis_finds_the_right_images() {
+    // A periodic axis of exactly three cells, two procCubes along it: a slide that wraps.
+    let base = box_deck([12, 6, 4], 3.015, &["x"])
+        .replace("steps = 1\ndt = 1e-3", "steps = 300\ndt = 5e-3")
+        .replace("critical_stretch = 0.01", "critical_stretch = 0.02");
+    let slide = "[[initial]]\nregion = { shape = \"box\", min = [0, 0, 0], max = [12, 6, 4] }\nvelocity = [20, 0, 0]\n[[initial]]\nregion = { shape = \"box\", min = [0, 0, 0], max = [12, 6, 1] }\nvelocity = [20.5, 0, 0]\n";
+    let plain = format!("{base}{slide}[parallel]\nskin = 0.25\n");
+    let shuffled = format!("{base}{slide}[parallel]\nshuffle_every = 5\n");
+    let a = run_layout(&plain, [1, 1, 1], Walls::Whole);
+    for procs in [[2, 1, 1], [3, 1, 1]] {
+        let b = run_layout(&shuffled, procs, Walls::Whole);
+        assert!(b.shuffles > 0);
+        assert_eq!(a.broken_pairs, b.broken_pairs, "{procs:?}");
+        let drift: Vec<[f64; 3]> = a.positions.clone();
+        // Shuffled positions are wrapped into the box; compare modulo the period.
+        let wrapped: Vec<[f64; 3]> = b
+            .positions
+            .iter()
+            .zip(&drift)
+            .map(|(p, q)| {
+                let k = ((q[0] - p[0]) / 12.0).round();
+                [p[0] + 12.0 * k, p[1], p[2]]
+            })
+            .collect();
+        let d = max_relative_difference(&a.positions, &wrapped);
+        assert!(d <= 1e-12, "{procs:?}: positions differ by {d:e}");
     }
 }
