@@ -88,16 +88,18 @@ impl Domain {
     }
 }
 
-fn layer_counts(domain: &Domain, cell_count: &[u32]) -> [Vec<u64>; 3] {
+/// Bond work of each layer of cells along each axis: what a procCube taking those layers
+/// evaluates (the pairs its cells scan), so that cuts balance work rather than particles.
+fn layer_work(domain: &Domain, cell_count: &[u32]) -> [Vec<u64>; 3] {
     let d = domain.grid.dims;
     let mut c = [vec![0u64; d[0]], vec![0u64; d[1]], vec![0u64; d[2]]];
     for z in 0..d[2] {
         for y in 0..d[1] {
             for x in 0..d[0] {
-                let n = cell_count[domain.grid.index([x, y, z])] as u64;
-                c[0][x] += n;
-                c[1][y] += n;
-                c[2][z] += n;
+                let w = cell_work(domain, cell_count, [x as i64, y as i64, z as i64]) as u64;
+                c[0][x] += w;
+                c[1][y] += w;
+                c[2][z] += w;
             }
         }
     }
@@ -135,7 +137,7 @@ fn balanced_cuts(counts: &[u64], parts: usize) -> Vec<usize> {
 }
 
 impl Layout {
-    /// `procs` procCubes cut from the domain's cells, balanced by particle count along each axis.
+    /// `procs` procCubes cut from the domain's cells, balanced by bond work along each axis.
     /// `cell_count` is the number of particles in each cell of the grid.
     pub fn new(
         procs: [usize; 3],
@@ -167,7 +169,7 @@ impl Layout {
         }
         let (_, start, order) = g.bin(x0);
         let cell_count: Vec<u32> = start.windows(2).map(|w| w[1] - w[0]).collect();
-        let counts = layer_counts(&domain, &cell_count);
+        let counts = layer_work(&domain, &cell_count);
         let cuts = [0, 1, 2].map(|a| balanced_cuts(&counts[a], procs[a]));
         Ok(Layout {
             procs,
@@ -281,8 +283,8 @@ impl Layout {
     }
 }
 
-/// Candidate pairs the owned cells of `p` scan: each cell with itself and its half shell.
-fn pair_work(domain: &Domain, p: &CellPlan, cell_count: &[u32]) -> f64 {
+/// Candidate pairs the cell at `at` scans: with itself and its half shell.
+fn cell_work(domain: &Domain, cell_count: &[u32], at: [i64; 3]) -> f64 {
     let g = &domain.grid;
     let count_at = |at: [i64; 3]| -> f64 {
         let mut c = [0usize; 3];
@@ -298,22 +300,25 @@ fn pair_work(domain: &Domain, p: &CellPlan, cell_count: &[u32]) -> f64 {
         }
         cell_count[g.index(c)] as f64
     };
+    let n = count_at(at);
+    let around: f64 = HALF_SHELL
+        .iter()
+        .map(|o| {
+            count_at([
+                at[0] + o[0] as i64,
+                at[1] + o[1] as i64,
+                at[2] + o[2] as i64,
+            ])
+        })
+        .sum();
+    n * (0.5 * n + around)
+}
+
+/// Candidate pairs the owned cells of `p` scan.
+fn pair_work(domain: &Domain, p: &CellPlan, cell_count: &[u32]) -> f64 {
     p.held[..p.owned_cells]
         .iter()
-        .map(|h| {
-            let n = cell_count[h.cell] as f64;
-            let around: f64 = HALF_SHELL
-                .iter()
-                .map(|o| {
-                    count_at([
-                        h.at[0] + o[0] as i64,
-                        h.at[1] + o[1] as i64,
-                        h.at[2] + o[2] as i64,
-                    ])
-                })
-                .sum();
-            n * (0.5 * n + around)
-        })
+        .map(|h| cell_work(domain, cell_count, h.at))
         .sum()
 }
 

@@ -576,7 +576,12 @@ fn prepare<M: Model>(
         .map_err(|e| format!("cannot create output directory {}: {e}", dir.display()))?;
     if !opts.quiet {
         eprint!("{}", describe(setup, scene));
-        eprintln!("parallel   {} on {n} {workers}", layout.describe());
+        let unit = if n == 1 {
+            workers.trim_end_matches('s')
+        } else {
+            workers
+        };
+        eprintln!("parallel   {} on {n} {unit}", layout.describe());
         eprintln!("output     {}", dir.display());
     }
     Ok(())
