@@ -85,6 +85,8 @@ struct ParallelSection {
     walls: Option<String>,
     shuffle_every: Option<i64>,
     skin: Option<f64>,
+    /// The thesis's cell factor: cells are this many horizons wide (1 + skin).
+    cell_factor: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -834,7 +836,23 @@ impl Converter {
                 )
             }
         };
-        let skin = match p.skin {
+        let skin = match (p.skin, p.cell_factor) {
+            (Some(_), Some(_)) => {
+                return self.err(
+                    line,
+                    "[parallel] give 'skin' or 'cell_factor' (= 1 + skin), not both",
+                )
+            }
+            (None, Some(f)) if f.is_finite() && (1.0..=11.0).contains(&f) => Some(f - 1.0),
+            (None, Some(f)) => {
+                return self.err(
+                    line,
+                    format!("[parallel] cell_factor = {f}: cells are cell_factor horizons wide; give a number from 1 to 11 (below 1 a cell would be thinner than the horizon)"),
+                )
+            }
+            (s, None) => s,
+        };
+        let skin = match skin {
             None if shuffle_every > 0 => 0.25,
             None => 0.0,
             Some(s) if s.is_finite() && (0.0..=10.0).contains(&s) => s,

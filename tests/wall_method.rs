@@ -409,6 +409,8 @@ fn layouts_that_cannot_work_say_what_to_change() {
         ("procs = \"many\"", "\"auto\""),
         ("threads = 3\nprocs = [2, 1, 1]", "one procCube per thread"),
         ("walls = \"thin\"", "trimmed"),
+        ("cell_factor = 0.5", "thinner than the horizon"),
+        ("cell_factor = 1.5\nskin = 0.5", "not both"),
     ] {
         let text = format!("{}\n[parallel]\n{bad}\n", fracture_deck(""));
         let e = deck::parse(&text, "t.toml", "t").unwrap_err().to_string();
