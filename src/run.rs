@@ -697,6 +697,15 @@ pub fn check(scene: &Scene) -> Result<String, String> {
         fn visit<M: Model>(self, model: M) -> Self::Output {
             let mut setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
             let mut s = describe(&setup, self.0);
+            // The deck's layout is checked here too, so a run does not find it wrong later.
+            let threads = self.0.parallel.threads;
+            let layout = choose_layout(&setup, self.0, &RunOptions::default(), threads)?;
+            let _ = writeln!(
+                s,
+                "parallel   {} for {threads} thread{} (one core is timed below)",
+                layout.describe(),
+                if threads == 1 { "" } else { "s" }
+            );
             let _ = writeln!(s, "setup      {:.2} s", setup.seconds);
             let calib = 5.min(setup.steps.max(1));
             let t = Instant::now();
