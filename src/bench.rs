@@ -176,7 +176,7 @@ impl ModelVisitor for MpiVisit<'_> {
         let (rank, ranks) = (mpi.rank(), mpi.size());
         let setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
         let layout = parallel::layout(&setup, &Procs::Auto, ranks, self.1.walls)?;
-        let plans = parallel::plans(&layout);
+        let plans = crate::decomposition::cell_plans(&layout);
         let cube = parallel::build_cube(&setup, &layout, &plans, rank, Box::new(mpi));
         let n = setup.sim.particles.len();
         drop(setup);
@@ -193,6 +193,16 @@ impl ModelVisitor for MpiVisit<'_> {
     }
 }
 
+/// `mpirun -np ranks`, allowed to run as root (containers) and on more ranks than cores.
+fn mpirun(ranks: usize) -> Command {
+    let mut c = Command::new("mpirun");
+    c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .args(["--oversubscribe", "-np"])
+        .arg(ranks.to_string());
+    c
+}
+
 /// Runs this program's bench under `mpirun -np ranks` and returns its line.
 fn ranks_line(opts: &BenchOptions, ranks: usize) -> Result<String, String> {
     if !cfg!(feature = "mpi") {
@@ -201,11 +211,7 @@ fn ranks_line(opts: &BenchOptions, ranks: usize) -> Result<String, String> {
         ));
     }
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
-    let out = Command::new("mpirun")
-        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .args(["--oversubscribe", "-np"])
-        .arg(ranks.to_string())
+    let out = mpirun(ranks)
         .arg(exe)
         .args(["bench", "--model", &opts.model, "--threads", "1", "--steps"])
         .arg(opts.steps.to_string())
@@ -420,12 +426,8 @@ fn peer(opts: &BenchOptions, ranks: usize) -> Result<Result<(String, f64), Strin
     let input = dir.join("lammps_pmb.in");
     std::fs::write(&input, LAMMPS_PMB).map_err(|e| e.to_string())?;
     let mut cmd = if ranks > 1 {
-        let mut c = Command::new("mpirun");
-        c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-            .args(["--oversubscribe", "-np"])
-            .arg(ranks.to_string())
-            .arg(&lmp);
+        let mut c = mpirun(ranks);
+        c.arg(&lmp);
         c
     } else {
         Command::new(&lmp)

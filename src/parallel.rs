@@ -135,11 +135,6 @@ pub fn layout<M: Model>(
     }
 }
 
-/// The cell plans of all procCubes (computed identically by every worker).
-pub fn plans(layout: &Layout) -> Vec<CellPlan> {
-    cell_plans(layout)
-}
-
 /// Builds procCube `rank` from the whole scene.
 pub fn build_cube<M: Model>(
     setup: &Setup<M>,
@@ -151,30 +146,15 @@ pub fn build_cube<M: Model>(
     let plan = cube_plan(layout, plans, rank);
     let g = &setup.sim.particles;
     let idx = |l: usize| plan.global[l] as usize;
-    let n = plan.global.len();
-    let x0: Vec<[f64; 3]> = (0..n)
-        .map(|l| {
-            let (x, s) = (g.x0[idx(l)], plan.shift[l]);
-            [x[0] + s[0], x[1] + s[1], x[2] + s[2]]
-        })
-        .collect();
-    let mut p = Particles::new(
+    let p = local_particles(
         &setup.sim.model,
-        (0..n).map(|l| g.gid[idx(l)]).collect(),
-        x0,
-        (0..n).map(|l| g.volume[idx(l)]).collect(),
-        (0..n).map(|l| g.material[idx(l)]).collect(),
+        &plan,
+        &g.gid,
+        &g.x0,
+        &g.volume,
+        &g.material,
+        &g.alter,
     );
-    p.n_owned = plan.n_owned;
-    for l in 0..n {
-        let mut a = g.alter[idx(l)];
-        let s = plan.shift[l];
-        let v = a.as_mut_slice();
-        for k in 0..3 {
-            v[k] += s[k];
-        }
-        p.alter[l] = a;
-    }
     let bonds: BondList<M::Bond> =
         plan.find_bonds(&p.x0, setup.horizon, setup.spacing, setup.partial_volume);
 
@@ -201,6 +181,37 @@ pub fn build_cube<M: Model>(
         everywhere,
         dropped: Vec::new(),
     }
+}
+
+/// The particles of `plan`, owned then ghosts, from whole-scene arrays indexed as
+/// `plan.global` indexes; ghosts that are periodic images are shifted by their period.
+pub(crate) fn local_particles<M: Model>(
+    model: &M,
+    plan: &CubePlan,
+    gid: &[u32],
+    x0: &[[f64; 3]],
+    volume: &[f64],
+    material: &[u16],
+    alter: &[M::Alter],
+) -> Particles<M> {
+    let shifted = |x: &[f64], s: [f64; 3]| [x[0] + s[0], x[1] + s[1], x[2] + s[2]];
+    let at = |l: usize| plan.global[l] as usize;
+    let n = plan.global.len();
+    let mut p = Particles::new(
+        model,
+        (0..n).map(|l| gid[at(l)]).collect(),
+        (0..n).map(|l| shifted(&x0[at(l)], plan.shift[l])).collect(),
+        (0..n).map(|l| volume[at(l)]).collect(),
+        (0..n).map(|l| material[at(l)]).collect(),
+    );
+    p.n_owned = plan.n_owned;
+    for l in 0..n {
+        let mut a = alter[at(l)];
+        let pos = shifted(a.as_slice(), plan.shift[l]);
+        a.as_mut_slice()[..3].copy_from_slice(&pos);
+        p.alter[l] = a;
+    }
+    p
 }
 
 impl<M: Model> Cube<M> {
@@ -269,7 +280,7 @@ impl<M: Model> Cube<M> {
 
 /// Builds every procCube of `layout` for threads of this process.
 pub fn thread_cubes<M: Model>(setup: &Setup<M>, layout: &Layout) -> Vec<Cube<M>> {
-    let plans = plans(layout);
+    let plans = cell_plans(layout);
     crate::comm::Threads::team(layout.cubes())
         .into_iter()
         .enumerate()

@@ -509,7 +509,7 @@ fn run_setup<M: Model>(
             ..opts.clone()
         };
         prepare(&setup, scene, &quiet, &dir, &layout, "ranks", ranks)?;
-        let plans = parallel::plans(&layout);
+        let plans = crate::decomposition::cell_plans(&layout);
         let cube = parallel::build_cube(&setup, &layout, &plans, rank, Box::new(mpi));
         let p = plan(&layout);
         let store = (rank == 0).then(|| frame_store(setup));

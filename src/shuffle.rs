@@ -21,8 +21,7 @@ use crate::cells::HALF_SHELL;
 use crate::comm::{f64s, Team};
 use crate::decomposition::{cell_plans, cube_plan, Layout};
 use crate::model::{BondGeom, Model};
-use crate::parallel::Cube;
-use crate::particles::Particles;
+use crate::parallel::{local_particles, Cube};
 use std::collections::HashMap;
 
 /// Fixed part of a particle record: gid, x0 (3), volume, material, initial bonds, lost bonds.
@@ -169,29 +168,18 @@ impl<M: Model> Cube<M> {
         // This procCube's particles, owned then ghosts (images shifted).
         let m = plan.global.len();
         let g = |l: usize| plan.global[l] as usize;
-        let mut part = Particles::new(
+        let ids: Vec<u32> = (0..n as u32).collect();
+        let mut part = local_particles(
             &self.sim.model,
-            (0..m).map(|l| g(l) as u32).collect(),
-            (0..m)
-                .map(|l| {
-                    let (x, s) = (x0[g(l)], plan.shift[l]);
-                    [x[0] + s[0], x[1] + s[1], x[2] + s[2]]
-                })
-                .collect(),
-            (0..m).map(|l| volume[g(l)]).collect(),
-            (0..m).map(|l| material[g(l)]).collect(),
+            &plan,
+            &ids,
+            &x0,
+            &volume,
+            &material,
+            &alter,
         );
-        part.n_owned = plan.n_owned;
-        for l in 0..m {
-            let mut a = alter[g(l)];
-            let v = a.as_mut_slice();
-            for (x, s) in v.iter_mut().zip(plan.shift[l]) {
-                *x += s;
-            }
-            part.alter[l] = a;
-            if l < plan.n_owned {
-                part.force[l] = force[g(l)];
-            }
+        for l in 0..plan.n_owned {
+            part.force[l] = force[g(l)];
         }
 
         // Bonds this procCube evaluates: from the cell of one end to the same cell or a
