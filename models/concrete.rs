@@ -11,7 +11,7 @@
 //! Two different concrete (or steel) materials bond with the series stiffness and the tighter
 //! limits.
 
-use crate::model::{check_options, stretch, BondGeom, MaterialKind, Model, ModelBuild, Side};
+use crate::model::{bond_based_lame, check_options, stretch, BondGeom, MaterialKind, Model, ModelBuild, Side};
 use std::f64::consts::PI;
 
 pub use super::pmb::{Force3, Motion};
@@ -47,6 +47,7 @@ pub struct Concrete {
     laws: Vec<Law>,
     n: usize,
     density: Vec<f64>,
+    delta: f64,
 }
 
 impl Concrete {
@@ -187,6 +188,7 @@ impl Model for Concrete {
         Ok(Concrete {
             laws,
             n,
+            delta: b.horizon,
             density: b.materials.iter().map(|m| m.density).collect(),
         })
     }
@@ -200,8 +202,15 @@ impl Model for Concrete {
         self.laws[mi as usize * self.n + mj as usize]
     }
 
-    fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> f64 {
-        law.stiffness() / geom.length
+    fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> Force3 {
+        Force3 {
+            force: [law.stiffness() / geom.length; 3],
+        }
+    }
+
+    fn lame(&self, material: u16) -> (f64, f64) {
+        let own = self.law(material, material);
+        bond_based_lame(own.stiffness(), self.delta)
     }
 
     #[inline(always)]

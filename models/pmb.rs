@@ -5,7 +5,7 @@
 //! THEORY.md §1. A bond between two materials takes the series stiffness 2c_a c_b/(c_a + c_b)
 //! and the smaller critical stretch.
 
-use crate::model::{check_options, stretch, BondGeom, Model, ModelBuild, Side};
+use crate::model::{bond_based_lame, check_options, stretch, BondGeom, Model, ModelBuild, Side};
 use std::f64::consts::PI;
 
 crate::attributes! {
@@ -31,6 +31,7 @@ pub struct Pmb {
     laws: Vec<Law>,
     n: usize,
     density: Vec<f64>,
+    delta: f64,
 }
 
 impl Pmb {
@@ -135,6 +136,7 @@ impl Model for Pmb {
         Ok(Pmb {
             laws,
             n,
+            delta: b.horizon,
             density: b.materials.iter().map(|m| m.density).collect(),
         })
     }
@@ -148,8 +150,15 @@ impl Model for Pmb {
         self.laws[mi as usize * self.n + mj as usize]
     }
 
-    fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> f64 {
-        law.c / geom.length
+    fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> Force3 {
+        Force3 {
+            force: [law.c / geom.length; 3],
+        }
+    }
+
+    fn lame(&self, material: u16) -> (f64, f64) {
+        let own = self.law(material, material);
+        bond_based_lame(own.c, self.delta)
     }
 
     #[inline(always)]

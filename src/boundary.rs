@@ -1,13 +1,19 @@
 //! Boundary conditions and loads on sets of particles, as functions of time.
 //!
 //! Kinematic conditions act on generalized degrees of freedom (0, 1, 2 = x, y, z translation;
-//! a model with rotations adds 3, 4, 5): the DOF's force is taken out (and reported as the
-//! support's reaction) and its velocity is set so that the drift lands exactly on the
-//! prescribed value. Loads add forces on the translational DOFs.
+//! a model with rotations adds 3, 4, 5; first-order DOFs such as temperature follow the
+//! second-order ones): the DOF's force is taken out (and reported as the support's reaction:
+//! for a temperature, the heat the support supplies) and its velocity is set so that the drift
+//! lands exactly on the prescribed value; a first-order value is set directly. Loads add
+//! forces (or heat) starting at a DOF.
 
 use crate::attributes::Attributes;
-use crate::model::Model;
+use crate::model::{second_order, Model};
 use crate::particles::Particles;
+
+/// The deck's name for the first first-order DOF (temperature); setup turns it into the
+/// model's index (the number of second-order DOFs).
+pub const TEMPERATURE: usize = usize::MAX;
 
 /// How a prescribed value varies with time: a factor applied to the deck's value.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,14 +125,29 @@ impl Constraint {
         }
     }
 
-    /// Sets velocities for the drift from `t` to `t + dt`, so positions land on the target.
+    /// A first-order DOF's prescribed value at `t` (temperatures are absolute), if any.
+    fn first_order_value(&self, k: usize, t: f64) -> Option<f64> {
+        match &self.motion {
+            Motion::Displacement(u) => Some(u[k] * self.history.factor(t)),
+            _ => None,
+        }
+    }
+
+    /// Sets velocities for the drift from `t` to `t + dt`, so positions land on the target,
+    /// and first-order values to their targets at `t + dt`.
     pub fn set_drift_velocity<M: Model>(&self, p: &mut Particles<M>, t: f64, dt: f64) {
-        let n = <M::Force as Attributes>::LEN;
+        let n = second_order::<M>();
         for &i in &self.particles {
             let i = i as usize;
             let x0 = p.x0[i];
             let a = p.alter[i].as_mut_slice();
             for (k, &d) in self.dofs.iter().enumerate() {
+                if d >= n {
+                    if let Some(v) = self.first_order_value(k, t + dt) {
+                        a[n + d] = v;
+                    }
+                    continue;
+                }
                 a[n + d] = match &self.motion {
                     Motion::Fixed => 0.0,
                     Motion::Velocity(v) => v[k] * self.history.factor(t + 0.5 * dt),
@@ -141,10 +162,16 @@ impl Constraint {
 
     /// Sets the velocities reported at time `t` (end of a step of length `dt`).
     pub fn set_velocity<M: Model>(&self, p: &mut Particles<M>, t: f64, dt: f64) {
-        let n = <M::Force as Attributes>::LEN;
+        let n = second_order::<M>();
         for &i in &self.particles {
             let a = p.alter[i as usize].as_mut_slice();
             for (k, &d) in self.dofs.iter().enumerate() {
+                if d >= n {
+                    if let Some(v) = self.first_order_value(k, t) {
+                        a[n + d] = v;
+                    }
+                    continue;
+                }
                 a[n + d] = match &self.motion {
                     Motion::Fixed => 0.0,
                     Motion::Velocity(v) => v[k] * self.history.factor(t),
@@ -157,13 +184,15 @@ impl Constraint {
     }
 }
 
-/// External forces on the translational DOFs: `vector · weight_i · factor(t)` on particle i.
+/// External generalized forces `vector · weight_i · factor(t)` on particle i, on the DOFs
+/// from `dof` on (0 for forces on x, y, z; the temperature DOF for heat, with one value).
 #[derive(Clone, Debug)]
 pub struct Load {
     pub name: String,
     pub particles: Vec<u32>,
     pub weight: Vec<f64>,
     pub vector: [f64; 3],
+    pub dof: usize,
     pub history: History,
 }
 
@@ -171,9 +200,10 @@ impl Load {
     pub fn apply<M: Model>(&self, p: &mut Particles<M>, t: f64) {
         let f = self.history.factor(t);
         let v = [self.vector[0] * f, self.vector[1] * f, self.vector[2] * f];
+        let len = 3.min(<M::Force as Attributes>::LEN - self.dof);
         for (&i, &w) in self.particles.iter().zip(&self.weight) {
-            let force = p.force[i as usize].as_mut_slice();
-            for k in 0..3 {
+            let force = &mut p.force[i as usize].as_mut_slice()[self.dof..];
+            for k in 0..len {
                 force[k] += v[k] * w;
             }
         }

@@ -5,7 +5,7 @@
 //! checked against the dimension the key expects and converted once into the deck's unit system
 //! (see [`crate::units`]); anything semantically wrong is reported with the entry's line.
 
-use crate::boundary::{History, Motion};
+use crate::boundary::{History, Motion, TEMPERATURE};
 use crate::decomposition::{Procs, Walls};
 use crate::geometry::{Bar, Lattice, Op, Shape};
 use crate::model::{Material, MaterialKind};
@@ -132,6 +132,10 @@ struct MaterialSection {
     failure_stretch: Option<f64>,
     #[serde(alias = "fc")]
     compressive_strength: Option<Stress>,
+    /// Heat conduction and expansion: plain numbers in the deck's units and degrees.
+    thermal_conductivity: Option<f64>,
+    specific_heat: Option<f64>,
+    thermal_expansion: Option<f64>,
 }
 
 /// A shape for geometry entries and regions; which keys apply depends on `shape`.
@@ -204,6 +208,8 @@ struct BoundarySection {
     fixed: Option<Vec<String>>,
     velocity: Option<VelocityVector>,
     displacement: Option<Position>,
+    /// Prescribed temperature (models with a temperature DOF), in the deck's degrees.
+    temperature: Option<f64>,
     components: Option<Vec<String>>,
     history: Option<HistorySpec>,
 }
@@ -217,6 +223,12 @@ struct LoadSection {
     total_force: Option<ForceVector>,
     body_force: Option<Vector<1, -2, -2>>,
     gravity: Option<AccelerationVector>,
+    /// Heat per unit time and area into a region one lattice layer thick.
+    heat_flux: Option<f64>,
+    /// Heat per unit time and volume.
+    heat_source: Option<f64>,
+    /// Heat per unit time shared by volume.
+    total_heat: Option<f64>,
     history: Option<HistorySpec>,
 }
 
@@ -224,7 +236,11 @@ struct LoadSection {
 #[serde(deny_unknown_fields)]
 struct InitialSection {
     region: Option<ShapeSpec>,
-    velocity: VelocityVector,
+    velocity: Option<VelocityVector>,
+    /// Radians per unit time (models with rotations).
+    angular_velocity: Option<Vector<0, 0, -1>>,
+    /// Models with a temperature DOF.
+    temperature: Option<f64>,
 }
 
 #[derive(Deserialize, Default)]
@@ -305,6 +321,22 @@ pub enum LoadKind {
     BodyForce([f64; 3]),
     /// Acceleration, applied as mass × g.
     Gravity([f64; 3]),
+    /// Heat per unit time and area, on a region one lattice layer thick (V_i / spacing each).
+    HeatFlux(f64),
+    /// Heat per unit time and volume.
+    HeatSource(f64),
+    /// Heat per unit time, shared by volume.
+    TotalHeat(f64),
+}
+
+impl LoadKind {
+    /// Whether the load heats (first-order temperature DOF) rather than pushes.
+    pub fn is_heat(&self) -> bool {
+        matches!(
+            self,
+            LoadKind::HeatFlux(_) | LoadKind::HeatSource(_) | LoadKind::TotalHeat(_)
+        )
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -320,7 +352,9 @@ pub struct LoadSpec {
 pub struct InitialSpec {
     pub line: usize,
     pub region: Region,
-    pub velocity: [f64; 3],
+    pub velocity: Option<[f64; 3]>,
+    pub angular_velocity: Option<[f64; 3]>,
+    pub temperature: Option<f64>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -676,11 +710,35 @@ impl Converter {
                 Some(r) => self.region(r, line, "initial")?,
                 None => Region::All,
             };
-            initial.push(InitialSpec {
+            let vector = |v: Option<[f64; 3]>, what: &str| -> R<Option<[f64; 3]>> {
+                v.map(|v| self.finite3(v, line, &format!("initial: {what}")))
+                    .transpose()
+            };
+            let spec = InitialSpec {
                 line,
                 region,
-                velocity: self.finite3(s.velocity.value(sys), line, "initial: velocity")?,
-            });
+                velocity: vector(s.velocity.map(|v| v.value(sys)), "velocity")?,
+                angular_velocity: vector(
+                    s.angular_velocity.map(|v| v.value(sys)),
+                    "angular_velocity",
+                )?,
+                temperature: s.temperature,
+            };
+            if let Some(t) = spec.temperature {
+                if !t.is_finite() {
+                    return self.err(line, format!("initial: temperature must be finite (got {t})"));
+                }
+            }
+            if spec.velocity.is_none()
+                && spec.angular_velocity.is_none()
+                && spec.temperature.is_none()
+            {
+                return self.err(
+                    line,
+                    "initial: give 'velocity', 'angular_velocity' or 'temperature'",
+                );
+            }
+            initial.push(spec);
         }
 
         // Output and probes.
@@ -936,6 +994,14 @@ impl Converter {
             }
         }
         mat.poisson_ratio = s.poisson_ratio;
+        mat.thermal_conductivity = positive(s.thermal_conductivity, "thermal_conductivity")?;
+        mat.specific_heat = positive(s.specific_heat, "specific_heat")?;
+        if let Some(a) = s.thermal_expansion {
+            if !a.is_finite() {
+                return self.err(line, format!("{ctx}: thermal_expansion must be finite (got {a})"));
+            }
+        }
+        mat.thermal_expansion = s.thermal_expansion;
         Ok(mat)
     }
 
@@ -1197,11 +1263,16 @@ impl Converter {
                 "y" => &[1],
                 "z" => &[2],
                 "all" => &[0, 1, 2],
+                "rx" => &[3],
+                "ry" => &[4],
+                "rz" => &[5],
+                "rotation" => &[3, 4, 5],
+                "temperature" => &[TEMPERATURE],
                 other => {
                     return self.err(
                         line,
                         format!(
-                        "{ctx}: unknown component '{other}' (use \"x\", \"y\", \"z\" or \"all\")"
+                        "{ctx}: unknown component '{other}' (use \"x\", \"y\", \"z\", \"all\", \"rx\", \"ry\", \"rz\", \"rotation\" or \"temperature\")"
                     ),
                     )
                 }
@@ -1236,6 +1307,22 @@ impl Converter {
             }
         };
         let (dofs, motion) = match (&b.fixed, b.velocity, b.displacement) {
+            _ if b.temperature.is_some() => {
+                if b.fixed.is_some() || b.velocity.is_some() || b.displacement.is_some() {
+                    return self.err(
+                        line,
+                        format!("{ctx}: give exactly one of 'fixed', 'velocity', 'displacement' or 'temperature'"),
+                    );
+                }
+                if b.components.is_some() {
+                    return self.err(line, format!("{ctx}: 'temperature' takes no components"));
+                }
+                let t = b.temperature.unwrap_or_default();
+                if !t.is_finite() {
+                    return self.err(line, format!("{ctx}: temperature must be finite (got {t})"));
+                }
+                (vec![TEMPERATURE], Motion::Displacement(vec![t]))
+            }
             (Some(f), None, None) => {
                 if b.components.is_some() {
                     return self.err(line, format!("{ctx}: 'fixed' lists its own components"));
@@ -1244,6 +1331,9 @@ impl Converter {
             }
             (None, Some(v), None) => {
                 let dofs = comps(&b.components)?;
+                if dofs.iter().any(|&d| d > 2) {
+                    return self.err(line, format!("{ctx}: 'velocity' prescribes x, y, z only"));
+                }
                 let v = self.finite3(v.value(self.sys), line, &format!("{ctx}: velocity"))?;
                 (
                     dofs.clone(),
@@ -1252,6 +1342,12 @@ impl Converter {
             }
             (None, None, Some(u)) => {
                 let dofs = comps(&b.components)?;
+                if dofs.iter().any(|&d| d > 2) {
+                    return self.err(
+                        line,
+                        format!("{ctx}: 'displacement' prescribes x, y, z only"),
+                    );
+                }
                 let u = self.finite3(u.value(self.sys), line, &format!("{ctx}: displacement"))?;
                 (
                     dofs.clone(),
@@ -1261,7 +1357,7 @@ impl Converter {
             _ => {
                 return self.err(
                     line,
-                    format!("{ctx}: give exactly one of 'fixed', 'velocity' or 'displacement'"),
+                    format!("{ctx}: give exactly one of 'fixed', 'velocity', 'displacement' or 'temperature'"),
                 )
             }
         };
@@ -1290,6 +1386,9 @@ impl Converter {
             l.total_force.map(|v| LoadKind::Total(v.value(sys))),
             l.body_force.map(|v| LoadKind::BodyForce(v.value(sys))),
             l.gravity.map(|v| LoadKind::Gravity(v.value(sys))),
+            l.heat_flux.map(LoadKind::HeatFlux),
+            l.heat_source.map(LoadKind::HeatSource),
+            l.total_heat.map(LoadKind::TotalHeat),
         ]
         .into_iter()
         .flatten()
@@ -1297,14 +1396,22 @@ impl Converter {
         if kinds.len() != 1 {
             return self.err(
                 line,
-                format!("{ctx}: give exactly one of 'force_per_particle', 'total_force', 'body_force' or 'gravity'"),
+                format!("{ctx}: give exactly one of 'force_per_particle', 'total_force', 'body_force', 'gravity', 'heat_flux', 'heat_source' or 'total_heat'"),
             );
         }
-        let (LoadKind::PerParticle(v)
-        | LoadKind::Total(v)
-        | LoadKind::BodyForce(v)
-        | LoadKind::Gravity(v)) = kinds[0];
-        self.finite3(v, line, &format!("{ctx}: the load vector"))?;
+        match kinds[0] {
+            LoadKind::PerParticle(v)
+            | LoadKind::Total(v)
+            | LoadKind::BodyForce(v)
+            | LoadKind::Gravity(v) => {
+                self.finite3(v, line, &format!("{ctx}: the load vector"))?;
+            }
+            LoadKind::HeatFlux(q) | LoadKind::HeatSource(q) | LoadKind::TotalHeat(q) => {
+                if !q.is_finite() {
+                    return self.err(line, format!("{ctx}: the heat must be finite (got {q})"));
+                }
+            }
+        }
         let region = match &l.region {
             Some(r) => self.region(r, line, &ctx)?,
             None => Region::All,

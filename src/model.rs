@@ -45,6 +45,9 @@ pub struct Material {
     pub yield_stretch: Option<f64>,
     pub failure_stretch: Option<f64>,
     pub compressive_strength: Option<f64>,
+    pub thermal_conductivity: Option<f64>,
+    pub specific_heat: Option<f64>,
+    pub thermal_expansion: Option<f64>,
 }
 
 impl Material {
@@ -65,6 +68,9 @@ impl Material {
             yield_stretch: None,
             failure_stretch: None,
             compressive_strength: None,
+            thermal_conductivity: None,
+            specific_heat: None,
+            thermal_expansion: None,
         }
     }
 
@@ -81,6 +87,9 @@ impl Material {
             ("compressive_stretch", self.compressive_stretch.is_some()),
             ("yield_stretch", self.yield_stretch.is_some()),
             ("failure_stretch", self.failure_stretch.is_some()),
+            ("thermal_conductivity", self.thermal_conductivity.is_some()),
+            ("specific_heat", self.specific_heat.is_some()),
+            ("thermal_expansion", self.thermal_expansion.is_some()),
         ]
         .into_iter()
         .filter(|(_, set)| *set)
@@ -181,9 +190,13 @@ impl<M: Model> Side<'_, M> {
 
 /// A peridynamic model: data declarations plus the physics of one bond.
 ///
-/// Layout convention for `Alter`: the first `Force::LEN` values are the generalized
-/// coordinates (current position first), the next `Force::LEN` their velocities; anything after
-/// that is free for the model. The integrators rely on it, so a model needs no integration code.
+/// Layout convention: `Force` holds one generalized force per degree of freedom, the
+/// second-order ones (translations, rotations) first and the `FIRST_ORDER` ones (temperature)
+/// last. `Alter` holds the n₂ = `Force::LEN − FIRST_ORDER` generalized coordinates (current
+/// position first), then their n₂ velocities, then the first-order values; anything after that
+/// is free for the model. The integrators rely on it, so a model needs no integration code
+/// (a model whose coordinates are not a vector space, such as finite rotations, overrides
+/// [`Model::drift`]).
 pub trait Model: Sized + Clone + Send + Sync + 'static {
     /// The name a deck uses (`[model] name = "…"`).
     const NAME: &'static str;
@@ -191,6 +204,11 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     const SUMMARY: &'static str;
     /// Options accepted in `[model.options]`: name and meaning.
     const OPTIONS: &'static [(&'static str, &'static str)] = &[];
+    /// How many of the last generalized forces are rates of first-order degrees of freedom
+    /// (heat flowing into a particle), integrated by forward Euler: q += Δt·F / inertia.
+    const FIRST_ORDER: usize = 0;
+    /// Whether [`Model::bond_fixed`] adds bond sums to the fixed data (LPS weighted volume).
+    const FIXED_FROM_BONDS: bool = false;
 
     /// Changes during a run: generalized coordinates, then their velocities, then extras.
     type Alter: Attributes;
@@ -214,14 +232,56 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
         Self::Fixed::default()
     }
 
-    /// Mass (or inertia) of each generalized degree of freedom.
+    /// Contribution of a bond, in the reference configuration, to both ends' fixed data; summed
+    /// once when families are found, over the whole family even across procCube faces (LPS
+    /// weighted volume m_i = Σ ω L² V_j β). Only called if `FIXED_FROM_BONDS`.
+    fn bond_fixed(
+        &self,
+        _law: &Self::Law,
+        _i: &Side<Self>,
+        _j: &Side<Self>,
+        _geom: &BondGeom,
+    ) -> (Self::Fixed, Self::Fixed) {
+        (Self::Fixed::default(), Self::Fixed::default())
+    }
+
+    /// Mass (or rotational inertia, or heat capacity) of each generalized degree of freedom.
     fn inertia(&self, material: u16, volume: f64, fixed: &Self::Fixed) -> Self::Force;
 
     /// The law of a bond between materials `mi` and `mj`.
     fn law(&self, mi: u16, mj: u16) -> Self::Law;
 
-    /// Stiffness C_ij = c/|ξ| of a bond for the Silling–Askari stable time step (THEORY.md §4).
-    fn bond_stiffness(&self, law: &Self::Law, geom: &BondGeom) -> f64;
+    /// Stiffness of a bond for each degree of freedom, for the stable time step (THEORY.md §4):
+    /// C_ij = c/|ξ| for translations (Silling–Askari), the moment per unit rotation for
+    /// rotations, the conductance per unit temperature difference for first-order DOFs; all
+    /// per unit volume of both ends.
+    fn bond_stiffness(&self, law: &Self::Law, geom: &BondGeom) -> Self::Force;
+
+    /// Continuum Lamé constants (λ, μ) the model is calibrated to for `material`: the targets
+    /// of the energy surface correction and of validation.
+    fn lame(&self, material: u16) -> (f64, f64);
+
+    /// q += h·v on the coordinates of one particle. The default adds; a model whose
+    /// coordinates are not a vector space (finite rotations) composes instead.
+    #[inline(always)]
+    fn drift(&self, alter: &mut Self::Alter, h: f64) {
+        let n = <Self::Force as Attributes>::LEN - Self::FIRST_ORDER;
+        let a = alter.as_mut_slice();
+        for k in 0..n {
+            a[k] += h * a[n + k];
+        }
+    }
+
+    /// Elastic energy of a particle that is not in any one bond (LPS: K θ²/2 · V_i).
+    fn particle_energy(
+        &self,
+        _material: u16,
+        _volume: f64,
+        _fixed: &Self::Fixed,
+        _state: &Self::State,
+    ) -> f64 {
+        0.0
+    }
 
     /// Contribution of an intact bond to both ends' state (only called if `State` is not `()`).
     fn state(
@@ -249,7 +309,8 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
         bond: &mut Self::Bond,
     ) -> Option<(Self::Force, Self::Force)>;
 
-    /// Elastic energy stored in an intact bond (whole bond, both volumes included).
+    /// Elastic energy stored in an intact bond (whole bond, both volumes included); with
+    /// [`Model::particle_energy`] it makes the strain energy.
     fn energy(
         &self,
         law: &Self::Law,
@@ -258,6 +319,19 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
         geom: &BondGeom,
         bond: &Self::Bond,
     ) -> f64;
+}
+
+/// Number of second-order degrees of freedom of model `M` (coordinates with velocities).
+#[inline(always)]
+pub fn second_order<M: Model>() -> usize {
+    <M::Force as Attributes>::LEN - M::FIRST_ORDER
+}
+
+/// Lamé constants (λ, μ) of a bond-based solid of micromodulus `c` and horizon `delta`:
+/// K = πδ⁴c/18 and ν = 1/4, so λ = μ = 3K/5 (THEORY.md §1).
+pub fn bond_based_lame(c: f64, delta: f64) -> (f64, f64) {
+    let k = std::f64::consts::PI * delta.powi(4) * c / 18.0;
+    (0.6 * k, 0.6 * k)
 }
 
 /// Bond stretch and the current bond vector: shared by every bond-based law.

@@ -97,6 +97,7 @@ impl Everywhere {
                     particles: m.iter().map(|&(_, i)| i).collect(),
                     weight: m.iter().map(|&(k, _)| l.weight[k]).collect(),
                     vector: l.vector,
+                    dof: l.dof,
                     history: l.history.clone(),
                 }
             })
@@ -222,6 +223,18 @@ impl<M: Model> Cube<M> {
         self.wall().reverse(&mut counts, |a, b| *a += b);
         for (c, v) in self.sim.bonds.initial.iter_mut().zip(&counts) {
             *c = *v as u32;
+        }
+        if M::FIXED_FROM_BONDS {
+            let sim = &mut self.sim;
+            let mut sums = crate::forces::bond_fixed_sums(&sim.model, &sim.particles, &sim.bonds);
+            self.wall().reverse(&mut sums, crate::attributes::add_assign);
+            let p = &mut self.sim.particles;
+            for (f, s) in p.fixed.iter_mut().zip(&sums).take(p.n_owned) {
+                crate::attributes::add_assign(f, s);
+            }
+            let mut fixed = std::mem::take(&mut self.sim.particles.fixed);
+            self.wall().forward(&mut fixed, false);
+            self.sim.particles.fixed = fixed;
         }
         for c in &self.sim.constraints {
             c.set_velocity(&mut self.sim.particles, 0.0, self.sim.dt);

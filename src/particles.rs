@@ -5,7 +5,7 @@
 //! contiguous array each, so the force loop streams only what the model reads.
 
 use crate::attributes::Attributes;
-use crate::model::{Model, Side};
+use crate::model::{second_order, Model, Side};
 
 pub struct Particles<M: Model> {
     /// Particles `0..n_owned` are integrated here; the rest are ghosts (copies of neighbours').
@@ -32,10 +32,10 @@ impl<M: Model> Particles<M> {
         material: Vec<u16>,
     ) -> Self {
         let n = gid.len();
+        let n2 = second_order::<M>();
         assert!(
-            <M::Alter as Attributes>::LEN >= 2 * <M::Force as Attributes>::LEN
-                && <M::Force as Attributes>::LEN >= 3,
-            "model '{}': Alter must hold coordinates then velocities (see Model docs)",
+            <M::Alter as Attributes>::LEN >= 2 * n2 + M::FIRST_ORDER && n2 >= 3,
+            "model '{}': Alter must hold coordinates, velocities, then first-order values (see Model docs)",
             M::NAME
         );
         let fixed: Vec<M::Fixed> = (0..n)
@@ -110,18 +110,18 @@ impl<M: Model> Particles<M> {
     /// Generalized velocities of particle `i`.
     #[inline]
     pub fn velocity(&self, i: usize) -> &[f64] {
-        let n = <M::Force as Attributes>::LEN;
+        let n = second_order::<M>();
         &self.alter[i].as_slice()[n..2 * n]
     }
 
     pub fn velocity_mut(&mut self, i: usize) -> &mut [f64] {
-        let n = <M::Force as Attributes>::LEN;
+        let n = second_order::<M>();
         &mut self.alter[i].as_mut_slice()[n..2 * n]
     }
 
-    /// Kinetic energy of the owned particles, over every generalized degree of freedom.
+    /// Kinetic energy of the owned particles, over every second-order degree of freedom.
     pub fn kinetic_energy(&self) -> f64 {
-        let n = <M::Force as Attributes>::LEN;
+        let n = second_order::<M>();
         let mut e = 0.0;
         for i in 0..self.n_owned {
             let a = self.alter[i].as_slice();
@@ -135,7 +135,7 @@ impl<M: Model> Particles<M> {
 
     /// Total linear momentum of the owned particles.
     pub fn momentum(&self) -> [f64; 3] {
-        let n = <M::Force as Attributes>::LEN;
+        let n = second_order::<M>();
         let mut p = [0.0; 3];
         for i in 0..self.n_owned {
             let a = self.alter[i].as_slice();

@@ -81,7 +81,7 @@ fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
     }
     for b in &setup.sim.constraints {
         for &d in &b.dofs {
-            c.push(format!("reaction_{}_{}", b.name, dof_name(d)));
+            c.push(format!("reaction_{}_{}", b.name, dof_name::<M>(d)));
         }
     }
     for (name, _) in &setup.probes {
@@ -92,13 +92,24 @@ fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
     c
 }
 
-fn dof_name(d: usize) -> String {
-    match d {
-        0 => "x".into(),
-        1 => "y".into(),
-        2 => "z".into(),
-        k => format!("dof{k}"),
+/// x, y, z for translations, else the model's name of the generalized force (`moment_x`,
+/// `heat`).
+fn dof_name<M: Model>(d: usize) -> String {
+    if d < 3 {
+        return ["x", "y", "z"][d].into();
     }
+    let mut offset = 0;
+    for f in <M::Force as Attributes>::FIELDS {
+        if d < offset + f.len {
+            return match f.len {
+                1 => f.name.to_string(),
+                3 => format!("{}_{}", f.name, ["x", "y", "z"][d - offset]),
+                _ => format!("{}{}", f.name, d - offset),
+            };
+        }
+        offset += f.len;
+    }
+    format!("dof{d}")
 }
 
 /// One procCube's share of a history row, reduced over all procCubes; the root gets the row.

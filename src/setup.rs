@@ -3,12 +3,12 @@
 
 use crate::attributes::Attributes;
 use crate::bonds::BondList;
-use crate::boundary::{Constraint, Load};
+use crate::boundary::{Constraint, Load, TEMPERATURE};
 use crate::cells::CellGrid;
 use crate::deck::{DeckError, LoadKind, Region, RunLength, Scene};
 use crate::decomposition::Domain;
 use crate::geometry;
-use crate::model::{Model, ModelBuild, ModelVisitor};
+use crate::model::{second_order, Model, ModelBuild, ModelVisitor};
 use crate::particles::Particles;
 use crate::simulation::{stable_time_step, Simulation};
 use std::time::Instant;
@@ -115,6 +115,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         scene.spacing,
         scene.partial_volume,
     );
+    crate::forces::add_bond_fixed(&model, &mut particles, &bonds);
 
     // Particles in one place (overlapping bars, say) would make a bond of length zero.
     if let Some((i, j, _)) = bonds
@@ -170,16 +171,37 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         ));
     }
 
-    // Initial velocities.
-    let nf = <M::Force as Attributes>::LEN;
+    // Initial velocities and temperatures.
+    let n2 = second_order::<M>();
     for init in &scene.initial {
-        let sel = select(&particles, &init.region, &gid_to_index)
-            .map_err(|e| scene.error(Some(init.line), format!("initial: {e}")))?;
+        let at = |what: &str| scene.error(Some(init.line), format!("initial: {what}"));
+        let sel = select(&particles, &init.region, &gid_to_index).map_err(|e| at(&e))?;
         if sel.is_empty() {
-            return Err(scene.error(Some(init.line), "initial: the region selects no particle"));
+            return Err(at("the region selects no particle"));
+        }
+        if init.angular_velocity.is_some() && n2 < 6 {
+            return Err(at(&format!(
+                "model '{}' has no rotations for 'angular_velocity'",
+                M::NAME
+            )));
+        }
+        if init.temperature.is_some() && M::FIRST_ORDER == 0 {
+            return Err(at(&format!(
+                "model '{}' has no temperature",
+                M::NAME
+            )));
         }
         for i in sel {
-            particles.alter[i as usize].as_mut_slice()[nf..nf + 3].copy_from_slice(&init.velocity);
+            let a = particles.alter[i as usize].as_mut_slice();
+            if let Some(v) = init.velocity {
+                a[n2..n2 + 3].copy_from_slice(&v);
+            }
+            if let Some(w) = init.angular_velocity {
+                a[n2 + 3..n2 + 6].copy_from_slice(&w);
+            }
+            if let Some(t) = init.temperature {
+                a[2 * n2] = t;
+            }
         }
     }
 
@@ -194,10 +216,16 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
                 format!("boundary '{}': the region selects no particle", b.name),
             ));
         }
+        let mut dofs = Vec::with_capacity(b.dofs.len());
+        for &d in &b.dofs {
+            dofs.push(dof_index::<M>(d).map_err(|e| {
+                scene.error(Some(b.line), format!("boundary '{}': {e}", b.name))
+            })?);
+        }
         constraints.push(Constraint::new(
             &b.name,
             sel,
-            b.dofs.clone(),
+            dofs,
             b.motion.clone(),
             b.history.clone(),
         ));
@@ -213,6 +241,12 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
             ));
         }
         let volume_of = |i: &u32| particles.volume[*i as usize];
+        if l.kind.is_heat() && M::FIRST_ORDER == 0 {
+            return Err(scene.error(
+                Some(l.line),
+                format!("load '{}': model '{}' has no temperature to heat", l.name, M::NAME),
+            ));
+        }
         let (vector, weight): ([f64; 3], Vec<f64>) = match l.kind {
             LoadKind::PerParticle(v) => (v, vec![1.0; sel.len()]),
             LoadKind::Total(v) => {
@@ -226,12 +260,22 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
                     .map(|&i| 1.0 / particles.inv_inertia[i as usize].as_slice()[0])
                     .collect(),
             ),
+            LoadKind::HeatFlux(q) => (
+                [q, 0.0, 0.0],
+                sel.iter().map(|i| volume_of(i) / scene.spacing).collect(),
+            ),
+            LoadKind::HeatSource(q) => ([q, 0.0, 0.0], sel.iter().map(volume_of).collect()),
+            LoadKind::TotalHeat(q) => {
+                let total: f64 = sel.iter().map(volume_of).sum();
+                ([q, 0.0, 0.0], sel.iter().map(|i| volume_of(i) / total).collect())
+            }
         };
         loads.push(Load {
             name: l.name.clone(),
             particles: sel,
             weight,
             vector,
+            dof: if l.kind.is_heat() { n2 } else { 0 },
             history: l.history.clone(),
         });
     }
@@ -316,6 +360,25 @@ fn domain(points: &[[f64; 3]], scene: &Scene) -> Result<Domain, DeckError> {
         periodic: scene.periodic,
         period,
     })
+}
+
+/// The model's index of a DOF the deck names (x, y, z, rotations, temperature).
+fn dof_index<M: Model>(d: usize) -> Result<usize, String> {
+    let n2 = second_order::<M>();
+    if d == TEMPERATURE {
+        return if M::FIRST_ORDER > 0 {
+            Ok(n2)
+        } else {
+            Err(format!("model '{}' has no temperature", M::NAME))
+        };
+    }
+    if d >= n2 {
+        return Err(format!(
+            "model '{}' has no rotations (it has {n2} degrees of freedom per particle)",
+            M::NAME
+        ));
+    }
+    Ok(d)
 }
 
 fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -55,6 +55,7 @@ impl<M: Model> Cube<M> {
         }
         let la = <M::Alter as Attributes>::LEN;
         let lf = <M::Force as Attributes>::LEN;
+        let lx = <M::Fixed as Attributes>::LEN;
         let lh = <M::Bond as Attributes>::LEN;
         let p = &self.sim.particles;
         let b = &self.sim.bonds;
@@ -68,6 +69,7 @@ impl<M: Model> Cube<M> {
             mine.push(self.lost[i] as f64);
             mine.extend_from_slice(p.alter[i].as_slice());
             mine.extend_from_slice(p.force[i].as_slice());
+            mine.extend_from_slice(p.fixed[i].as_slice());
         }
         for (i, j, k) in b.iter() {
             mine.extend_from_slice(&[
@@ -100,6 +102,7 @@ impl<M: Model> Cube<M> {
         let mut lost = vec![0u32; n];
         let mut alter = vec![M::Alter::default(); n];
         let mut force = vec![M::Force::default(); n];
+        let mut fixed = vec![M::Fixed::default(); n];
         let mut bonds: Vec<(u32, u32, BondGeom, M::Bond)> = Vec::new();
         let mut dropped: Vec<(u32, u32)> = Vec::new();
         let mut at = 0;
@@ -107,7 +110,7 @@ impl<M: Model> Cube<M> {
             let (np, nb, nd) = (all[at] as usize, all[at + 1] as usize, all[at + 2] as usize);
             at += 3;
             for _ in 0..np {
-                let r = &all[at..at + PARTICLE_HEAD + la + lf];
+                let r = &all[at..at + PARTICLE_HEAD + la + lf + lx];
                 let g = r[0] as usize;
                 x0[g] = [r[1], r[2], r[3]];
                 volume[g] = r[4];
@@ -120,8 +123,12 @@ impl<M: Model> Cube<M> {
                     .copy_from_slice(&r[PARTICLE_HEAD..PARTICLE_HEAD + la]);
                 force[g]
                     .as_mut_slice()
-                    .copy_from_slice(&r[PARTICLE_HEAD + la..]);
-                at += PARTICLE_HEAD + la + lf;
+                    .copy_from_slice(&r[PARTICLE_HEAD + la..PARTICLE_HEAD + la + lf]);
+                // Fixed data travels whole: bond sums (LPS weighted volume) are not redone.
+                fixed[g]
+                    .as_mut_slice()
+                    .copy_from_slice(&r[PARTICLE_HEAD + la + lf..]);
+                at += PARTICLE_HEAD + la + lf + lx;
             }
             for _ in 0..nb {
                 let r = &all[at..at + BOND_HEAD + lh];
@@ -180,6 +187,9 @@ impl<M: Model> Cube<M> {
         );
         for l in 0..plan.n_owned {
             part.force[l] = force[g(l)];
+        }
+        for l in 0..m {
+            part.fixed[l] = fixed[g(l)];
         }
 
         // Bonds this procCube evaluates: from the cell of one end to the same cell or a

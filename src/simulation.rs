@@ -1,8 +1,9 @@
 //! One procCube's time stepping: particles and bonds, forces, loads and constraints, integration.
 //!
 //! ```text
-//! kick → constrain → drift → exchange (forward) → [state pass → reverse-sum → finish]
-//!      → pair pass → reverse force sum → loads, constraints → kick → constrain
+//! first-order DOFs (Euler) → kick → constrain → drift → exchange (forward)
+//!      → [state pass → reverse-sum → finish] → pair pass → reverse force sum
+//!      → loads, constraints → kick → constrain
 //! ```
 //! The exchange points are where the wall method's ghost messages go; a single procCube with
 //! no periodic axis has no ghosts and [`Local`] does nothing there.
@@ -12,7 +13,7 @@ use crate::bonds::BondList;
 use crate::boundary::{Constraint, Load};
 use crate::comm::{Solo, Transport};
 use crate::forces;
-use crate::model::Model;
+use crate::model::{second_order, Model};
 use crate::particles::Particles;
 use crate::timing::{Phase, Timing};
 use crate::wall::WallExchange;
@@ -122,9 +123,9 @@ impl<M: Model> Simulation<M> {
         broken
     }
 
-    /// v += h·F/m on every owned generalized DOF.
+    /// v += h·F/m on every owned second-order DOF.
     fn kick(&mut self, h: f64) {
-        let n = <M::Force as Attributes>::LEN;
+        let n = second_order::<M>();
         let p = &mut self.particles;
         for i in 0..p.n_owned {
             let f = p.force[i].as_slice();
@@ -136,15 +137,29 @@ impl<M: Model> Simulation<M> {
         }
     }
 
-    /// q += h·v on every owned generalized DOF.
-    fn drift(&mut self, h: f64) {
-        let n = <M::Force as Attributes>::LEN;
+    /// q += h·F/C on every owned first-order DOF (forward Euler with the rates of the last
+    /// force evaluation). Compiled away for models without first-order DOFs.
+    fn advance_first_order(&mut self, h: f64) {
+        if M::FIRST_ORDER == 0 {
+            return;
+        }
+        let n = second_order::<M>();
         let p = &mut self.particles;
         for i in 0..p.n_owned {
+            let f = p.force[i].as_slice();
+            let inv = p.inv_inertia[i].as_slice();
             let a = p.alter[i].as_mut_slice();
-            for k in 0..n {
-                a[k] += h * a[n + k];
+            for k in 0..M::FIRST_ORDER {
+                a[2 * n + k] += h * f[n + k] * inv[n + k];
             }
+        }
+    }
+
+    /// q += h·v on every owned second-order DOF (the model composes finite rotations).
+    fn drift(&mut self, h: f64) {
+        let p = &mut self.particles;
+        for a in &mut p.alter[..p.n_owned] {
+            self.model.drift(a, h);
         }
     }
 
@@ -152,6 +167,7 @@ impl<M: Model> Simulation<M> {
     pub fn advance(&mut self) -> usize {
         let (dt, t0) = (self.dt, self.time);
         let start = Instant::now();
+        self.advance_first_order(dt);
         match self.integrator {
             Integrator::VelocityVerlet => self.kick(0.5 * dt),
             Integrator::SemiImplicitEuler => self.kick(dt),
@@ -184,27 +200,42 @@ impl<M: Model> Simulation<M> {
     }
 }
 
-/// The Silling–Askari stable time step, min over particles of √(2ρ_i / Σ_j V_j C_ij)
-/// (THEORY.md §4), and the particle that sets it. Infinite if no particle has a bond.
+/// The stable time step and the particle that sets it (THEORY.md §4): for each second-order
+/// DOF the Silling–Askari bound √(2m / (V_i Σ_j V_j C_ij)), for each first-order DOF the
+/// forward-Euler bound C / (V_i Σ_j V_j K_ij) (Gershgorin: twice the diagonal bounds the
+/// largest eigenvalue). Infinite if no particle has a bond.
 pub fn stable_time_step<M: Model>(
     model: &M,
     p: &Particles<M>,
     bonds: &BondList<M::Bond>,
 ) -> (f64, usize) {
-    let mut sum = vec![0.0; p.len()];
+    let mut sum = vec![M::Force::default(); p.len()];
     for (i, j, b) in bonds.iter() {
         let law = model.law(p.material[i], p.material[j]);
         let c = model.bond_stiffness(&law, &bonds.geom[b]);
-        sum[i] += p.volume[j] * c;
-        sum[j] += p.volume[i] * c;
+        let c = c.as_slice();
+        for (k, v) in sum[i].as_mut_slice().iter_mut().enumerate() {
+            *v += p.volume[j] * c[k];
+        }
+        for (k, v) in sum[j].as_mut_slice().iter_mut().enumerate() {
+            *v += p.volume[i] * c[k];
+        }
     }
+    let n2 = second_order::<M>();
     let mut best = (f64::INFINITY, 0);
-    for (i, &s) in sum.iter().enumerate().take(p.n_owned) {
-        if s > 0.0 {
-            let rho = 1.0 / (p.inv_inertia[i].as_slice()[0] * p.volume[i]);
-            let dt = (2.0 * rho / s).sqrt();
-            if dt < best.0 {
-                best = (dt, i);
+    for (i, s) in sum.iter().enumerate().take(p.n_owned) {
+        let inv = p.inv_inertia[i].as_slice();
+        for (k, &s) in s.as_slice().iter().enumerate() {
+            if s > 0.0 {
+                let inertia = 1.0 / (inv[k] * p.volume[i] * s);
+                let dt = if k < n2 {
+                    (2.0 * inertia).sqrt()
+                } else {
+                    inertia
+                };
+                if dt < best.0 {
+                    best = (dt, i);
+                }
             }
         }
     }

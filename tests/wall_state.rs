@@ -49,8 +49,13 @@ impl Model for StretchSum {
         }
     }
     fn law(&self, _: u16, _: u16) {}
-    fn bond_stiffness(&self, _: &(), geom: &BondGeom) -> f64 {
-        self.c / geom.length
+    fn bond_stiffness(&self, _: &(), geom: &BondGeom) -> Force3 {
+        Force3 {
+            force: [self.c / geom.length; 3],
+        }
+    }
+    fn lame(&self, _: u16) -> (f64, f64) {
+        (0.0, 0.0)
     }
     fn state(
         &self,
