@@ -11,7 +11,9 @@
 //! Two different concrete (or steel) materials bond with the series stiffness and the tighter
 //! limits.
 
-use crate::model::{bond_based_lame, check_options, stretch, BondGeom, MaterialKind, Model, ModelBuild, Side};
+use crate::model::{
+    bond_based_lame, check_options, stretch, BondGeom, MaterialKind, Model, ModelBuild, Side,
+};
 use std::f64::consts::PI;
 
 pub use super::pmb::{Force3, Motion};
@@ -107,7 +109,7 @@ impl Model for Concrete {
 
     fn build(b: &ModelBuild) -> Result<Self, String> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
-        let factor = b.option("interface_factor").unwrap_or(3.0);
+        let factor = b.option("interface_factor")?.unwrap_or(3.0);
         if !(factor.is_finite() && factor > 0.0) {
             return Err("model option 'interface_factor' must be > 0".into());
         }

@@ -4,9 +4,11 @@
 //! type to the list below. `cargo build` is the whole workflow.
 
 pub mod concrete;
+pub mod lps;
 pub mod pmb;
 
 crate::model_registry! {
     pmb::Pmb,
     concrete::Concrete,
+    lps::Lps,
 }

@@ -8,7 +8,7 @@
 use crate::boundary::{History, Motion, TEMPERATURE};
 use crate::decomposition::{Procs, Walls};
 use crate::geometry::{Bar, Lattice, Op, Shape};
-use crate::model::{Material, MaterialKind};
+use crate::model::{Material, MaterialKind, OptionValue};
 use crate::simulation::Integrator;
 use crate::units::{
     AccelerationVector, Area, Density, EnergyPerArea, ForceVector, Length, Micromodulus, Position,
@@ -98,7 +98,16 @@ struct ModelSection {
     m: Option<f64>,
     partial_volume: Option<bool>,
     #[serde(default)]
-    options: BTreeMap<String, f64>,
+    options: BTreeMap<String, OptionSpec>,
+}
+
+/// A model option: a number or a word.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum OptionSpec {
+    Number(f64),
+    Integer(i64),
+    Word(String),
 }
 
 #[derive(Deserialize)]
@@ -385,7 +394,7 @@ pub struct Scene {
     pub units: UnitSystem,
     pub model: String,
     pub model_line: usize,
-    pub model_options: Vec<(String, f64)>,
+    pub model_options: Vec<(String, OptionValue)>,
     /// Deck line of each material (same order as `materials`) and of `[time]`, for messages.
     pub material_lines: Vec<usize>,
     pub time_line: usize,
@@ -726,7 +735,10 @@ impl Converter {
             };
             if let Some(t) = spec.temperature {
                 if !t.is_finite() {
-                    return self.err(line, format!("initial: temperature must be finite (got {t})"));
+                    return self.err(
+                        line,
+                        format!("initial: temperature must be finite (got {t})"),
+                    );
                 }
             }
             if spec.velocity.is_none()
@@ -806,7 +818,18 @@ impl Converter {
             units: sys,
             model: ms.name,
             model_line,
-            model_options: ms.options.into_iter().collect(),
+            model_options: ms
+                .options
+                .into_iter()
+                .map(|(k, v)| {
+                    let v = match v {
+                        OptionSpec::Number(x) => OptionValue::Number(x),
+                        OptionSpec::Integer(x) => OptionValue::Number(x as f64),
+                        OptionSpec::Word(w) => OptionValue::Word(w),
+                    };
+                    (k, v)
+                })
+                .collect(),
             material_lines,
             time_line,
             horizon,
@@ -998,7 +1021,10 @@ impl Converter {
         mat.specific_heat = positive(s.specific_heat, "specific_heat")?;
         if let Some(a) = s.thermal_expansion {
             if !a.is_finite() {
-                return self.err(line, format!("{ctx}: thermal_expansion must be finite (got {a})"));
+                return self.err(
+                    line,
+                    format!("{ctx}: thermal_expansion must be finite (got {a})"),
+                );
             }
         }
         mat.thermal_expansion = s.thermal_expansion;

@@ -4,6 +4,7 @@
 //! [`simulation`] (the step loop) → [`output`]. Models live in `models/`, one file each, and
 //! see nothing but the [`model::Model`] interface.
 
+pub mod analysis;
 pub mod attributes;
 pub mod bench;
 pub mod bonds;

@@ -118,23 +118,49 @@ impl Material {
     }
 }
 
+/// A value of `[model.options]`: a number or a word (`influence = "gaussian"`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum OptionValue {
+    Number(f64),
+    Word(String),
+}
+
 /// Everything a model is built from.
 #[derive(Clone, Debug)]
 pub struct ModelBuild<'a> {
     pub materials: &'a [Material],
     pub horizon: f64,
     pub spacing: f64,
-    /// Model-specific numeric options from the deck's `[model.options]`; a model rejects
-    /// names it does not know (see [`check_options`]).
-    pub options: &'a [(String, f64)],
+    /// Model-specific options from the deck's `[model.options]`; a model rejects names it does
+    /// not know (see [`check_options`]).
+    pub options: &'a [(String, OptionValue)],
 }
 
 impl ModelBuild<'_> {
-    pub fn option(&self, name: &str) -> Option<f64> {
-        self.options
-            .iter()
-            .find(|(k, _)| k == name)
-            .map(|(_, v)| *v)
+    fn value(&self, name: &str) -> Option<&OptionValue> {
+        self.options.iter().find(|(k, _)| k == name).map(|(_, v)| v)
+    }
+
+    /// A numeric option; a word there is an error naming the option.
+    pub fn option(&self, name: &str) -> Result<Option<f64>, String> {
+        match self.value(name) {
+            None => Ok(None),
+            Some(OptionValue::Number(x)) => Ok(Some(*x)),
+            Some(OptionValue::Word(w)) => Err(format!(
+                "[model.options] {name} takes a number, not \"{w}\""
+            )),
+        }
+    }
+
+    /// A word option; a number there is an error naming the option.
+    pub fn word(&self, name: &str) -> Result<Option<&str>, String> {
+        match self.value(name) {
+            None => Ok(None),
+            Some(OptionValue::Word(w)) => Ok(Some(w)),
+            Some(OptionValue::Number(x)) => Err(format!(
+                "[model.options] {name} takes a word, not the number {x}"
+            )),
+        }
     }
 }
 
@@ -142,7 +168,7 @@ impl ModelBuild<'_> {
 pub fn check_options(
     model: &str,
     known: &[(&str, &str)],
-    given: &[(String, f64)],
+    given: &[(String, OptionValue)],
 ) -> Result<(), String> {
     for (k, _) in given {
         if !known.iter().any(|(n, _)| n == k) {

@@ -227,7 +227,8 @@ impl<M: Model> Cube<M> {
         if M::FIXED_FROM_BONDS {
             let sim = &mut self.sim;
             let mut sums = crate::forces::bond_fixed_sums(&sim.model, &sim.particles, &sim.bonds);
-            self.wall().reverse(&mut sums, crate::attributes::add_assign);
+            self.wall()
+                .reverse(&mut sums, crate::attributes::add_assign);
             let p = &mut self.sim.particles;
             for (f, s) in p.fixed.iter_mut().zip(&sums).take(p.n_owned) {
                 crate::attributes::add_assign(f, s);

@@ -186,10 +186,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
             )));
         }
         if init.temperature.is_some() && M::FIRST_ORDER == 0 {
-            return Err(at(&format!(
-                "model '{}' has no temperature",
-                M::NAME
-            )));
+            return Err(at(&format!("model '{}' has no temperature", M::NAME)));
         }
         for i in sel {
             let a = particles.alter[i as usize].as_mut_slice();
@@ -218,9 +215,11 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         }
         let mut dofs = Vec::with_capacity(b.dofs.len());
         for &d in &b.dofs {
-            dofs.push(dof_index::<M>(d).map_err(|e| {
-                scene.error(Some(b.line), format!("boundary '{}': {e}", b.name))
-            })?);
+            dofs.push(
+                dof_index::<M>(d).map_err(|e| {
+                    scene.error(Some(b.line), format!("boundary '{}': {e}", b.name))
+                })?,
+            );
         }
         constraints.push(Constraint::new(
             &b.name,
@@ -244,7 +243,11 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         if l.kind.is_heat() && M::FIRST_ORDER == 0 {
             return Err(scene.error(
                 Some(l.line),
-                format!("load '{}': model '{}' has no temperature to heat", l.name, M::NAME),
+                format!(
+                    "load '{}': model '{}' has no temperature to heat",
+                    l.name,
+                    M::NAME
+                ),
             ));
         }
         let (vector, weight): ([f64; 3], Vec<f64>) = match l.kind {
@@ -267,7 +270,10 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
             LoadKind::HeatSource(q) => ([q, 0.0, 0.0], sel.iter().map(volume_of).collect()),
             LoadKind::TotalHeat(q) => {
                 let total: f64 = sel.iter().map(volume_of).sum();
-                ([q, 0.0, 0.0], sel.iter().map(|i| volume_of(i) / total).collect())
+                (
+                    [q, 0.0, 0.0],
+                    sel.iter().map(|i| volume_of(i) / total).collect(),
+                )
             }
         };
         loads.push(Load {

@@ -1,0 +1,301 @@
+//! LPS: Silling's linear peridynamic solid, ordinary state-based (Silling et al. 2007;
+//! THEORY.md §2), any Poisson's ratio.
+//!
+//! * weighted volume m_i = Σ_j ω L² V_j β, summed once over the reference family (broken bonds
+//!   keep counting, as in Peridigm);
+//! * dilatation θ_i = (3/m_i) Σ_j ω L e V_j β over intact bonds (the state pass);
+//! * force state t_i = ω[(3K − 5G) θ_i L / m_i + 15G e / m_i], i.e. 3Kθ_i ω L/m_i plus 15G/m_i
+//!   times ω times the deviatoric extension e − θ_i L/3; the pair force on i is
+//!   (t_i + t_j) V_i V_j β along the current bond, each end with its own material's K and G;
+//! * energy (K/2) θ_i² V_i per particle plus (15G/(2m_i)) ω (e − θ_i L/3)² V_i V_j β per bond
+//!   end;
+//! * critical-stretch damage; from a fracture energy with PeriLab's
+//!   s_c = √(G0 / ([3G + (3/4)⁴ (K − 5G/3)] δ)), which depends on ω and is approximate.
+//!
+//! Influence functions (`[model.options] influence`): "one" (ω = 1, Peridigm's default),
+//! "inverse_length" (ω = δ/L, LAMMPS's and Peridynamics.jl's), "gaussian"
+//! (ω = exp(−L²/(0.4δ)²)).
+
+use crate::model::{check_options, BondGeom, Model, ModelBuild, Side};
+
+pub use super::pmb::{Force3, Motion};
+
+crate::attributes! {
+    /// m_i = Σ ω L² V_j β over the reference family.
+    pub struct WeightedVolume { pub weighted_volume: f64 }
+}
+
+crate::attributes! {
+    /// θ_i, the peridynamic volume strain.
+    pub struct Dilatation { pub dilatation: f64 }
+}
+
+/// How bonds are weighted by their reference length.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Influence {
+    One,
+    InverseLength,
+    Gaussian,
+}
+
+impl Influence {
+    fn parse(word: Option<&str>) -> Result<Influence, String> {
+        match word.unwrap_or("one") {
+            "one" | "1" => Ok(Influence::One),
+            "inverse_length" | "1/r" => Ok(Influence::InverseLength),
+            "gaussian" => Ok(Influence::Gaussian),
+            other => Err(format!(
+                "model 'lps': unknown influence '{other}' (use \"one\", \"inverse_length\" or \"gaussian\")"
+            )),
+        }
+    }
+}
+
+/// Moduli of both ends of a bond and its critical stretch: `a = 3K − 5G`, `b = 15G`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Law {
+    pub ai: f64,
+    pub bi: f64,
+    pub aj: f64,
+    pub bj: f64,
+    pub s0: f64,
+    /// PMB micromodulus of the same P-wave modulus, for the stable time step.
+    pub c_equivalent: f64,
+}
+
+#[derive(Clone, Debug)]
+pub struct Lps {
+    /// (K, G) of each material.
+    moduli: Vec<(f64, f64)>,
+    s0: Vec<f64>,
+    density: Vec<f64>,
+    delta: f64,
+    influence: Influence,
+}
+
+impl Lps {
+    #[inline(always)]
+    fn omega(&self, length: f64) -> f64 {
+        match self.influence {
+            Influence::One => 1.0,
+            Influence::InverseLength => self.delta / length,
+            Influence::Gaussian => {
+                let r = length / (0.4 * self.delta);
+                (-r * r).exp()
+            }
+        }
+    }
+}
+
+impl Model for Lps {
+    const NAME: &'static str = "lps";
+    const SUMMARY: &'static str =
+        "state-based linear peridynamic solid (Silling 2007): any nu, dilatation pass, critical stretch";
+    const OPTIONS: &'static [(&'static str, &'static str)] = &[(
+        "influence",
+        "influence function: \"one\" (default), \"inverse_length\" (delta/L) or \"gaussian\"",
+    )];
+    const FIXED_FROM_BONDS: bool = true;
+
+    type Alter = Motion;
+    type Fixed = WeightedVolume;
+    type Bond = ();
+    type State = Dilatation;
+    type Force = Force3;
+    type Law = Law;
+
+    fn build(b: &ModelBuild) -> Result<Self, String> {
+        check_options(Self::NAME, Self::OPTIONS, b.options)?;
+        let influence = Influence::parse(b.word("influence")?)?;
+        let delta = b.horizon;
+        let (mut moduli, mut s0) = (Vec::new(), Vec::new());
+        for m in b.materials {
+            m.only_uses(
+                &[
+                    "youngs_modulus",
+                    "bulk_modulus",
+                    "poisson_ratio",
+                    "critical_stretch",
+                    "fracture_energy",
+                ],
+                Self::NAME,
+            )?;
+            let nu = m.require(m.poisson_ratio, "poisson_ratio", Self::NAME)?;
+            let k = match (m.youngs_modulus, m.bulk_modulus) {
+                (Some(e), None) => e / (3.0 * (1.0 - 2.0 * nu)),
+                (None, Some(k)) => k,
+                _ => {
+                    return Err(format!(
+                        "material '{}' needs one of 'youngs_modulus' or 'bulk_modulus' (with 'poisson_ratio') for model 'lps'",
+                        m.name
+                    ))
+                }
+            };
+            let g = 3.0 * k * (1.0 - 2.0 * nu) / (2.0 * (1.0 + nu));
+            let s = match (m.critical_stretch, m.fracture_energy) {
+                (Some(s), None) => s,
+                (None, Some(g0)) => {
+                    (g0 / ((3.0 * g + 0.75f64.powi(4) * (k - 5.0 * g / 3.0)) * delta)).sqrt()
+                }
+                (None, None) => f64::INFINITY,
+                (Some(_), Some(_)) => {
+                    return Err(format!(
+                        "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
+                        m.name
+                    ))
+                }
+            };
+            if !(k.is_finite() && k > 0.0 && g > 0.0) {
+                return Err(format!(
+                    "material '{}': the moduli must be > 0 (K = {k:e}, G = {g:e})",
+                    m.name
+                ));
+            }
+            if s.is_nan() || s <= 0.0 {
+                return Err(format!(
+                    "material '{}': critical stretch must be > 0",
+                    m.name
+                ));
+            }
+            moduli.push((k, g));
+            s0.push(s);
+        }
+        Ok(Lps {
+            moduli,
+            s0,
+            density: b.materials.iter().map(|m| m.density).collect(),
+            delta,
+            influence,
+        })
+    }
+
+    fn inertia(&self, material: u16, volume: f64, _: &WeightedVolume) -> Force3 {
+        let m = self.density[material as usize] * volume;
+        Force3 { force: [m; 3] }
+    }
+
+    fn law(&self, mi: u16, mj: u16) -> Law {
+        let ((ki, gi), (kj, gj)) = (self.moduli[mi as usize], self.moduli[mj as usize]);
+        // A PMB solid has P-wave modulus πδ⁴c/10; the stiffer end sets the time step.
+        let p_wave = (ki + 4.0 * gi / 3.0).max(kj + 4.0 * gj / 3.0);
+        Law {
+            ai: 3.0 * ki - 5.0 * gi,
+            bi: 15.0 * gi,
+            aj: 3.0 * kj - 5.0 * gj,
+            bj: 15.0 * gj,
+            s0: self.s0[mi as usize].min(self.s0[mj as usize]),
+            c_equivalent: 10.0 * p_wave / (std::f64::consts::PI * self.delta.powi(4)),
+        }
+    }
+
+    fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> Force3 {
+        Force3 {
+            force: [law.c_equivalent / geom.length; 3],
+        }
+    }
+
+    fn lame(&self, material: u16) -> (f64, f64) {
+        let (k, g) = self.moduli[material as usize];
+        (k - 2.0 * g / 3.0, g)
+    }
+
+    fn bond_fixed(
+        &self,
+        _: &Law,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+    ) -> (WeightedVolume, WeightedVolume) {
+        let w = self.omega(geom.length) * geom.length * geom.length * geom.beta;
+        (
+            WeightedVolume {
+                weighted_volume: w * j.volume,
+            },
+            WeightedVolume {
+                weighted_volume: w * i.volume,
+            },
+        )
+    }
+
+    #[inline(always)]
+    fn state(
+        &self,
+        _: &Law,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+        _: &(),
+    ) -> (Dilatation, Dilatation) {
+        let (a, b) = (i.pos(), j.pos());
+        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let e = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt() - geom.length;
+        let w = 3.0 * self.omega(geom.length) * geom.length * e * geom.beta;
+        (
+            Dilatation {
+                dilatation: w * j.volume / i.fixed.weighted_volume,
+            },
+            Dilatation {
+                dilatation: w * i.volume / j.fixed.weighted_volume,
+            },
+        )
+    }
+
+    #[inline(always)]
+    fn pair(
+        &self,
+        law: &Law,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+        _: &mut (),
+    ) -> Option<(Force3, Force3)> {
+        let (a, b) = (i.pos(), j.pos());
+        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+        let l = geom.length;
+        let e = r - l;
+        if e > law.s0 * l {
+            return None;
+        }
+        let (inv_mi, inv_mj) = (1.0 / i.fixed.weighted_volume, 1.0 / j.fixed.weighted_volume);
+        let t = l * (law.ai * i.state.dilatation * inv_mi + law.aj * j.state.dilatation * inv_mj)
+            + e * (law.bi * inv_mi + law.bj * inv_mj);
+        let f = self.omega(l) * t * geom.beta * i.volume * j.volume / r;
+        let fi = [f * y[0], f * y[1], f * y[2]];
+        Some((
+            Force3 { force: fi },
+            Force3 {
+                force: [-fi[0], -fi[1], -fi[2]],
+            },
+        ))
+    }
+
+    fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {
+        let (a, b) = (i.pos(), j.pos());
+        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let l = geom.length;
+        let e = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt() - l;
+        let (ei, ej) = (
+            e - i.state.dilatation * l / 3.0,
+            e - j.state.dilatation * l / 3.0,
+        );
+        // b = 15G, so 15G/(2m) = b/(2m).
+        0.5 * self.omega(l)
+            * geom.beta
+            * i.volume
+            * j.volume
+            * (law.bi * ei * ei / i.fixed.weighted_volume
+                + law.bj * ej * ej / j.fixed.weighted_volume)
+    }
+
+    fn particle_energy(
+        &self,
+        material: u16,
+        volume: f64,
+        _: &WeightedVolume,
+        state: &Dilatation,
+    ) -> f64 {
+        let k = self.moduli[material as usize].0;
+        0.5 * k * state.dilatation * state.dilatation * volume
+    }
+}

@@ -1,0 +1,112 @@
+//! Each mechanical model against continuum elasticity: a block under homogeneous uniaxial
+//! strain, the virial stress at its centre particle (whose family and neighbours' families are
+//! whole), and the E and ν that stress implies, against the E and ν the deck gives.
+
+use pdq::analysis::{deform_affinely, virial_stress, young_poisson, CubicConstants};
+use pdq::model::Model;
+use pdq::{deck, setup};
+
+/// A cube of `n`³ particles (n odd, so one sits at the centre) on a 1 mm lattice with horizon
+/// m·spacing.
+fn block_deck(model: &str, m: f64, material: &str, options: &str, n: usize) -> String {
+    format!(
+        r#"
+units = "SI"
+[model]
+name = "{model}"
+m = {m}
+{options}
+[lattice]
+spacing = "1 mm"
+[materials.solid]
+density = "2000 kg/m^3"
+{material}
+[[geometry]]
+shape = "box"
+material = "solid"
+min = "0 0 0 mm"
+max = "{e} {e} {e} mm"
+[time]
+steps = 1
+[output]
+progress = false
+"#,
+        e = n
+    )
+}
+
+/// The cubic constants at the centre of a block: stress under uniaxial strain along x and
+/// under shear in xy, at the centre particle.
+pub fn constants<M: Model>(text: &str) -> CubicConstants {
+    let scene = deck::parse(text, "block.toml", "block").unwrap_or_else(|e| panic!("{e}"));
+    let mut s = setup::build_as::<M>(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let p = &s.sim.particles;
+    let (lo, hi) = p.x0.iter().fold((f64::INFINITY, 0.0f64), |(l, h), x| {
+        (l.min(x[0]), h.max(x[0]))
+    });
+    let mid = [0.5 * (lo + hi); 3];
+    let centre = (0..p.len())
+        .min_by(|&a, &b| {
+            let d = |i: usize| (0..3).map(|k| (p.x0[i][k] - mid[k]).powi(2)).sum::<f64>();
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    let mut stress = |h: [[f64; 3]; 3]| {
+        deform_affinely(&mut s.sim.particles, h, mid);
+        s.sim.compute_forces();
+        virial_stress(&s.sim.model, &s.sim.particles, &s.sim.bonds, centre)
+    };
+    let (eps, gamma) = (1e-4, 1e-4);
+    let uniaxial = stress([[eps, 0.0, 0.0], [0.0; 3], [0.0; 3]]);
+    let shear = stress([[0.0, 0.5 * gamma, 0.0], [0.5 * gamma, 0.0, 0.0], [0.0; 3]]);
+    CubicConstants::from_tests(&uniaxial, eps, &shear, gamma)
+}
+
+/// E and ν of the isotropic (orientation-averaged) solid the block stands for.
+pub fn recovered<M: Model>(text: &str) -> (f64, f64) {
+    let c = constants::<M>(text);
+    let (lambda, mu) = c.isotropic_lame();
+    println!(
+        "  C11 {:.4e} C12 {:.4e} C44 {:.4e} anisotropy {:.4}",
+        c.c11,
+        c.c12,
+        c.c44,
+        c.anisotropy()
+    );
+    young_poisson(lambda, mu)
+}
+
+fn check(label: &str, got: (f64, f64), e: f64, nu: f64, tol: f64) {
+    let (de, dnu) = ((got.0 - e) / e, (got.1 - nu) / nu);
+    println!(
+        "{label}: E = {:.4e} ({:+.2}%), nu = {:.4} ({:+.2}%)",
+        got.0,
+        100.0 * de,
+        got.1,
+        100.0 * dnu
+    );
+    assert!(
+        de.abs() < tol && dnu.abs() < tol,
+        "{label}: E and nu off by {:.2}% and {:.2}%",
+        100.0 * de,
+        100.0 * dnu
+    );
+}
+
+#[test]
+fn lps_recovers_e_and_nu() {
+    use pdq::models::lps::Lps;
+    for influence in ["one", "inverse_length", "gaussian"] {
+        for nu in [0.1, 0.2, 0.3, 0.4] {
+            let text = block_deck(
+                "lps",
+                3.0,
+                &format!("youngs_modulus = \"10 GPa\"\npoisson_ratio = {nu}"),
+                &format!("[model.options]\ninfluence = \"{influence}\""),
+                13,
+            );
+            let got = recovered::<Lps>(&text);
+            check(&format!("lps {influence} m=3 nu={nu}"), got, 10e9, nu, 0.02);
+        }
+    }
+}
