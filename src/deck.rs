@@ -97,6 +97,8 @@ struct ModelSection {
     /// Horizon as a multiple of the lattice spacing.
     m: Option<f64>,
     partial_volume: Option<bool>,
+    /// "none" (default) or "energy" (THEORY.md §6).
+    surface_correction: Option<String>,
     #[serde(default)]
     options: BTreeMap<String, OptionSpec>,
 }
@@ -401,6 +403,8 @@ pub struct Scene {
     pub horizon: f64,
     pub spacing: f64,
     pub partial_volume: bool,
+    /// Apply the energy surface correction to bond-based models.
+    pub surface_correction: bool,
     pub materials: Vec<Material>,
     pub lattice: Lattice,
     pub ops: Vec<Op>,
@@ -564,6 +568,23 @@ impl Converter {
             .unwrap_or([0.0; 3]);
         let model_line = self.line_of(&deck.model);
         let ms = deck.model.into_inner();
+        let surface_correction =
+            match ms.surface_correction.as_deref() {
+                None | Some("none") => false,
+                Some("energy") => true,
+                Some(other) => return self.err(
+                    model_line,
+                    format!(
+                        "[model] unknown surface_correction '{other}' (use \"none\" or \"energy\")"
+                    ),
+                ),
+            };
+        if surface_correction && !lattice_periodic.is_empty() {
+            return self.err(
+                model_line,
+                "[model] surface_correction = \"energy\" needs a body without periodic axes (the correction is found on the scene without its images)",
+            );
+        }
         let horizon = match (ms.horizon, ms.m) {
             (Some(h), None) => h.value(sys),
             (None, Some(m)) => m * spacing,
@@ -835,6 +856,7 @@ impl Converter {
             horizon,
             spacing,
             partial_volume: ms.partial_volume.unwrap_or(true),
+            surface_correction,
             materials,
             lattice: Lattice { spacing, origin },
             ops,

@@ -13,6 +13,7 @@ pub mod cells;
 pub mod comm;
 #[cfg(feature = "mpi")]
 pub mod comm_mpi;
+pub mod correction;
 pub mod deck;
 pub mod decomposition;
 pub mod forces;

@@ -156,8 +156,11 @@ pub fn build_cube<M: Model>(
         &g.material,
         &g.alter,
     );
-    let bonds: BondList<M::Bond> =
+    let mut bonds: BondList<M::Bond> =
         plan.find_bonds(&p.x0, setup.horizon, setup.spacing, setup.partial_volume);
+    if let Some(g) = &setup.correction {
+        crate::correction::correct_bonds(&mut bonds, &p.x0, |l| g[idx(l)]);
+    }
 
     // Global id → local index, for owned particles.
     let mut local = vec![u32::MAX; g.len()];

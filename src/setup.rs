@@ -28,6 +28,8 @@ pub struct Setup<M: Model> {
     pub horizon: f64,
     pub spacing: f64,
     pub partial_volume: bool,
+    /// Energy surface correction factors gᵢᵏ by store index, if the deck asks for them.
+    pub correction: Option<Vec<[f64; 3]>>,
 }
 
 /// Builds the model named by the deck and hands it to `visitor`.
@@ -115,7 +117,21 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         scene.spacing,
         scene.partial_volume,
     );
+    let mut bonds = bonds;
     crate::forces::add_bond_fixed(&model, &mut particles, &bonds);
+    let correction = if scene.surface_correction {
+        if <M::State as Attributes>::LEN > 0 {
+            return Err(scene.error(
+                Some(scene.model_line),
+                format!("[model] surface_correction = \"energy\" is for bond-based models; model '{}' is state-based (its weighted volume already uses the discrete family)", M::NAME),
+            ));
+        }
+        let g = crate::correction::energy_factors(&model, &mut particles, &bonds);
+        crate::correction::correct_bonds(&mut bonds, &particles.x0, |i| g[i]);
+        Some(g)
+    } else {
+        None
+    };
 
     // Particles in one place (overlapping bars, say) would make a bond of length zero.
     if let Some((i, j, _)) = bonds
@@ -322,6 +338,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         horizon: scene.horizon,
         spacing: scene.spacing,
         partial_volume: scene.partial_volume,
+        correction,
     })
 }
 
