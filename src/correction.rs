@@ -27,9 +27,8 @@ pub fn energy_factors<M: Model>(
     let saved = p.alter.clone();
     let mut g = vec![[1.0; 3]; n];
     for k in 0..3 {
-        for i in 0..n {
-            let x = p.x0[i][k];
-            p.alter[i].as_mut_slice()[k] = x * (1.0 + PROBE_STRAIN);
+        for (a, x) in p.alter.iter_mut().zip(&p.x0) {
+            a.as_mut_slice()[k] = x[k] * (1.0 + PROBE_STRAIN);
         }
         let mut w = vec![0.0; n];
         for (i, j, b) in bonds.iter() {
@@ -44,12 +43,12 @@ pub fn energy_factors<M: Model>(
             w[i] += 0.5 * e;
             w[j] += 0.5 * e;
         }
-        for i in 0..n {
+        for (i, gi) in g.iter_mut().enumerate() {
             let (lambda, mu) = model.lame(p.material[i]);
             let continuum = 0.5 * (lambda + 2.0 * mu) * PROBE_STRAIN * PROBE_STRAIN;
             let discrete = w[i] / p.volume[i];
             if discrete > 0.0 {
-                g[i][k] = continuum / discrete;
+                gi[k] = continuum / discrete;
             }
         }
         p.alter.clone_from(&saved);
