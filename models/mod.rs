@@ -5,10 +5,12 @@
 
 pub mod concrete;
 pub mod lps;
+pub mod micropolar;
 pub mod pmb;
 
 crate::model_registry! {
     pmb::Pmb,
     concrete::Concrete,
     lps::Lps,
+    micropolar::Micropolar,
 }

@@ -568,17 +568,18 @@ impl Converter {
             .unwrap_or([0.0; 3]);
         let model_line = self.line_of(&deck.model);
         let ms = deck.model.into_inner();
-        let surface_correction =
-            match ms.surface_correction.as_deref() {
-                None | Some("none") => false,
-                Some("energy") => true,
-                Some(other) => return self.err(
+        let surface_correction = match ms.surface_correction.as_deref() {
+            None | Some("none") => false,
+            Some("energy") => true,
+            Some(other) => {
+                return self.err(
                     model_line,
                     format!(
                         "[model] unknown surface_correction '{other}' (use \"none\" or \"energy\")"
                     ),
-                ),
-            };
+                )
+            }
+        };
         if surface_correction && !lattice_periodic.is_empty() {
             return self.err(
                 model_line,

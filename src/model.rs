@@ -271,6 +271,10 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
         (Self::Fixed::default(), Self::Fixed::default())
     }
 
+    /// A particle at rest in its reference configuration: position set, everything else zero;
+    /// a model whose zero is not "at rest" (an identity quaternion) fills it in here.
+    fn at_rest(&self, _alter: &mut Self::Alter) {}
+
     /// Mass (or rotational inertia, or heat capacity) of each generalized degree of freedom.
     fn inertia(&self, material: u16, volume: f64, fixed: &Self::Fixed) -> Self::Force;
 

@@ -46,6 +46,7 @@ impl<M: Model> Particles<M> {
             .map(|x| {
                 let mut a = M::Alter::default();
                 a.as_mut_slice()[..3].copy_from_slice(x);
+                model.at_rest(&mut a);
                 a
             })
             .collect();

@@ -77,7 +77,9 @@ pub fn recovered<M: Model>(text: &str) -> (f64, f64) {
 }
 
 fn check(label: &str, got: (f64, f64), e: f64, nu: f64, tol: f64) {
-    let (de, dnu) = ((got.0 - e) / e, (got.1 - nu) / nu);
+    // ν = 0 has no relative scale: its error is the value itself.
+    let dnu = if nu == 0.0 { got.1 } else { (got.1 - nu) / nu };
+    let de = (got.0 - e) / e;
     println!(
         "{label}: E = {:.4e} ({:+.2}%), nu = {:.4} ({:+.2}%)",
         got.0,
@@ -133,6 +135,35 @@ fn pmb_recovers_e_and_nu_with_the_energy_correction() {
             10e9,
             0.25,
             tol,
+        );
+    }
+}
+
+#[test]
+fn micropolar_recovers_e_and_nu() {
+    use pdq::models::micropolar::Micropolar;
+    for nu in [0.0, 0.1, 0.2, 0.25] {
+        let material = format!("youngs_modulus = \"10 GPa\"\npoisson_ratio = {nu}");
+        let raw = recovered::<Micropolar>(&block_deck("micropolar", 3.0, &material, "", 13));
+        println!(
+            "micropolar m=3 nu={nu} uncorrected: E {:+.2}%, nu {:.4}",
+            100.0 * (raw.0 / 10e9 - 1.0),
+            raw.1
+        );
+        let text = block_deck(
+            "micropolar",
+            4.0,
+            &material,
+            "surface_correction = \"energy\"",
+            17,
+        );
+        let got = recovered::<Micropolar>(&text);
+        check(
+            &format!("micropolar m=4 energy correction nu={nu}"),
+            got,
+            10e9,
+            nu,
+            0.02,
         );
     }
 }

@@ -1,0 +1,398 @@
+//! Micropolar bond-based peridynamics: six degrees of freedom per particle (displacement and
+//! rotation), a bond force and two unequal bond moments (THEORY.md §3, marked DERIVED there:
+//! energy equivalence, not a published law; docs/models.md lists what was verified).
+//!
+//! Each particle carries an orientation Q (a unit quaternion). For a bond of reference
+//! direction n₀ = ξ/L, current vector y and d_i = Q_i n₀:
+//!
+//! * s = (|y| − L)/L, g = y/L − ½(d_i + d_j) (g = s n + γ for small motion, with γ the
+//!   shear of THEORY.md §3), and φ the rotation from Q_i to Q_j;
+//! * micropotential w = ½L[(c_n − c_s) s² + c_s |g|²] + κ_φ (1 − cos|φ|)
+//!   (= ½L(c_n s² + c_s|γ|²) + ½κ_φ|φ|² for small motion);
+//! * force on i f = (c_n − c_s) s y/|y| + c_s g (j gets −f); moments
+//!   M_i = ½L c_s d_i × g + κ_φ sin|φ| φ̂ and M_j = ½L c_s d_j × g − κ_φ sin|φ| φ̂.
+//!
+//! w is unchanged by a rigid rotation of everything, so M_i + M_j = y × f holds exactly (to
+//! round-off, also for large rotations): angular momentum is conserved. Forces and moments are
+//! the exact derivatives of w, so energy is conserved too. Calibration (3D):
+//! c_n = 6E/(πδ⁴(1 − 2ν)), c_s = 6E(1 − 4ν)/(πδ⁴(1 + ν)(1 − 2ν)), so −1 < ν ≤ 1/4;
+//! κ_φ = `kappa` · c_n δ² (default 0; its value is not calibrated). Rotational inertia
+//! J = ρ V dx²/6 (a cube of side dx).
+//!
+//! Solids break at s0 = √(5G0(1 − 2ν)/(3Eδ)) (axial energy only) or a given critical stretch;
+//! concrete (kind = "concrete") at its tensile and compressive stretches s_c < s < s_t.
+
+use crate::model::{check_options, BondGeom, MaterialKind, Model, ModelBuild, Side};
+use std::f64::consts::PI;
+
+crate::attributes! {
+    /// Position, rotation vector, their velocities, then the orientation quaternion (w, x, y, z)
+    /// that the rotation vector summarizes.
+    pub struct Motion6 {
+        pub pos: [f64; 3],
+        pub rotation: [f64; 3],
+        pub vel: [f64; 3],
+        pub angular_velocity: [f64; 3],
+        pub orientation: [f64; 4],
+    }
+}
+
+crate::attributes! {
+    /// Force and moment.
+    pub struct Force6 { pub force: [f64; 3], pub moment: [f64; 3] }
+}
+
+/// Constants of one pair of materials.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Law {
+    /// c_n − c_s.
+    pub a: f64,
+    pub cs: f64,
+    pub kappa: f64,
+    pub tensile: f64,
+    pub compressive: f64,
+    /// max(c_n, c_s), for the stable time step.
+    pub c_max: f64,
+}
+
+/// c_n, c_s, tensile and compressive critical stretch of a material.
+#[derive(Clone, Copy, Debug)]
+struct Own {
+    cn: f64,
+    cs: f64,
+    tensile: f64,
+    compressive: f64,
+}
+
+#[derive(Clone, Debug)]
+pub struct Micropolar {
+    own: Vec<Own>,
+    density: Vec<f64>,
+    kappa: f64,
+    delta: f64,
+    spacing: f64,
+}
+
+#[inline(always)]
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// v rotated by the unit quaternion q = (w, u): v + 2w u×v + 2u×(u×v).
+#[inline(always)]
+fn rotate(q: &[f64; 4], v: [f64; 3]) -> [f64; 3] {
+    let u = [q[1], q[2], q[3]];
+    let t = cross(u, v);
+    let t = [2.0 * t[0], 2.0 * t[1], 2.0 * t[2]];
+    let c = cross(u, t);
+    [
+        v[0] + q[0] * t[0] + c[0],
+        v[1] + q[0] * t[1] + c[1],
+        v[2] + q[0] * t[2] + c[2],
+    ]
+}
+
+/// a ⊗ b.
+#[inline(always)]
+fn product(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
+    ]
+}
+
+/// sin|φ| φ̂ and 1 − cos|φ| of the rotation φ taking orientation `qi` to `qj` (spatial frame):
+/// from q = q_j ⊗ q_i*, sin|φ| φ̂ = 2 q_w q_v and 1 − cos|φ| = 2|q_v|².
+#[inline(always)]
+fn relative(qi: &[f64; 4], qj: &[f64; 4]) -> ([f64; 3], f64) {
+    let q = product(qj, &[qi[0], -qi[1], -qi[2], -qi[3]]);
+    (
+        [2.0 * q[0] * q[1], 2.0 * q[0] * q[2], 2.0 * q[0] * q[3]],
+        2.0 * (q[1] * q[1] + q[2] * q[2] + q[3] * q[3]),
+    )
+}
+
+/// The rotation vector of a unit quaternion.
+fn rotation_vector(q: &[f64; 4]) -> [f64; 3] {
+    let (w, v) = if q[0] < 0.0 {
+        (-q[0], [-q[1], -q[2], -q[3]])
+    } else {
+        (q[0], [q[1], q[2], q[3]])
+    };
+    let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if s < 1e-300 {
+        return [0.0; 3];
+    }
+    let k = 2.0 * s.atan2(w) / s;
+    [k * v[0], k * v[1], k * v[2]]
+}
+
+/// The unit quaternion of rotation vector `r`.
+fn quaternion(r: [f64; 3]) -> [f64; 4] {
+    let angle = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    let half = 0.5 * angle;
+    // sin(half)/angle, with its limit ½ at small angles.
+    let k = if angle < 1e-8 {
+        0.5 - angle * angle / 48.0
+    } else {
+        half.sin() / angle
+    };
+    [half.cos(), k * r[0], k * r[1], k * r[2]]
+}
+
+impl Micropolar {
+    /// The bond's strain measures: (y, |y|, s, d_i, d_j, g).
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    fn kinematics(
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+    ) -> ([f64; 3], f64, f64, [f64; 3], [f64; 3], [f64; 3]) {
+        let (a, b) = (i.pos(), j.pos());
+        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+        let l = geom.length;
+        let inv_l = 1.0 / l;
+        let n0 = [
+            (j.x0[0] - i.x0[0]) * inv_l,
+            (j.x0[1] - i.x0[1]) * inv_l,
+            (j.x0[2] - i.x0[2]) * inv_l,
+        ];
+        let di = rotate(&i.alter.orientation, n0);
+        let dj = rotate(&j.alter.orientation, n0);
+        let g = [
+            y[0] * inv_l - 0.5 * (di[0] + dj[0]),
+            y[1] * inv_l - 0.5 * (di[1] + dj[1]),
+            y[2] * inv_l - 0.5 * (di[2] + dj[2]),
+        ];
+        (y, r, (r - l) * inv_l, di, dj, g)
+    }
+}
+
+impl Model for Micropolar {
+    const NAME: &'static str = "micropolar";
+    const SUMMARY: &'static str =
+        "bond-based micropolar solid: displacements and rotations, bond force and two moments, nu <= 1/4 (DERIVED)";
+    const OPTIONS: &'static [(&'static str, &'static str)] = &[(
+        "kappa",
+        "relative-rotation stiffness as a multiple of c_n*delta^2 (default 0; uncalibrated)",
+    )];
+
+    type Alter = Motion6;
+    type Fixed = ();
+    type Bond = ();
+    type State = ();
+    type Force = Force6;
+    type Law = Law;
+
+    fn build(b: &ModelBuild) -> Result<Self, String> {
+        check_options(Self::NAME, Self::OPTIONS, b.options)?;
+        let kappa = b.option("kappa")?.unwrap_or(0.0);
+        if !(kappa.is_finite() && kappa >= 0.0) {
+            return Err(format!(
+                "model 'micropolar': kappa must be >= 0 (got {kappa})"
+            ));
+        }
+        let delta = b.horizon;
+        let mut own = Vec::new();
+        for m in b.materials {
+            let concrete = m.kind == MaterialKind::Concrete;
+            let breaking: &[&str] = if concrete {
+                &["tensile_stretch", "compressive_stretch"]
+            } else {
+                &["critical_stretch", "fracture_energy"]
+            };
+            let mut used = vec!["youngs_modulus", "poisson_ratio"];
+            used.extend_from_slice(breaking);
+            m.only_uses(&used, Self::NAME)?;
+            let e = m.require(m.youngs_modulus, "youngs_modulus", Self::NAME)?;
+            let nu = m.require(m.poisson_ratio, "poisson_ratio", Self::NAME)?;
+            if nu > 0.25 + 1e-12 {
+                return Err(format!(
+                    "material '{}': micropolar bonds need poisson_ratio <= 1/4 (c_s >= 0), the deck gives {nu}; use model 'lps' for larger values",
+                    m.name
+                ));
+            }
+            let d4 = PI * delta.powi(4);
+            let cn = 6.0 * e / (d4 * (1.0 - 2.0 * nu));
+            let cs = 6.0 * e * (1.0 - 4.0 * nu) / (d4 * (1.0 + nu) * (1.0 - 2.0 * nu));
+            let (tensile, compressive) = if concrete {
+                (
+                    m.require(m.tensile_stretch, "tensile_stretch", Self::NAME)?,
+                    m.require(m.compressive_stretch, "compressive_stretch", Self::NAME)?,
+                )
+            } else {
+                let s0 = match (m.critical_stretch, m.fracture_energy) {
+                    (Some(s), None) => s,
+                    (None, Some(g0)) => (5.0 * g0 * (1.0 - 2.0 * nu) / (3.0 * e * delta)).sqrt(),
+                    (None, None) => f64::INFINITY,
+                    (Some(_), Some(_)) => {
+                        return Err(format!(
+                            "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
+                            m.name
+                        ))
+                    }
+                };
+                (s0, f64::NEG_INFINITY)
+            };
+            own.push(Own {
+                cn,
+                cs,
+                tensile,
+                compressive,
+            });
+        }
+        Ok(Micropolar {
+            own,
+            density: b.materials.iter().map(|m| m.density).collect(),
+            kappa,
+            delta,
+            spacing: b.spacing,
+        })
+    }
+
+    fn inertia(&self, material: u16, volume: f64, _: &()) -> Force6 {
+        let m = self.density[material as usize] * volume;
+        let j = m * self.spacing * self.spacing / 6.0;
+        Force6 {
+            force: [m; 3],
+            moment: [j; 3],
+        }
+    }
+
+    fn law(&self, mi: u16, mj: u16) -> Law {
+        let (a, b) = (self.own[mi as usize], self.own[mj as usize]);
+        let series = |x: f64, y: f64| {
+            if x + y > 0.0 {
+                2.0 * x * y / (x + y)
+            } else {
+                0.0
+            }
+        };
+        let (cn, cs) = (series(a.cn, b.cn), series(a.cs, b.cs));
+        Law {
+            a: cn - cs,
+            cs,
+            kappa: self.kappa * cn * self.delta * self.delta,
+            tensile: a.tensile.min(b.tensile),
+            compressive: a.compressive.max(b.compressive),
+            c_max: cn.max(cs),
+        }
+    }
+
+    fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> Force6 {
+        let t = law.c_max / geom.length;
+        // THEORY.md §4: rotations bound the step through c_s L/4 + κ_φ.
+        let r = law.cs * geom.length / 4.0 + law.kappa;
+        Force6 {
+            force: [t; 3],
+            moment: [r; 3],
+        }
+    }
+
+    fn lame(&self, material: u16) -> (f64, f64) {
+        let o = self.own[material as usize];
+        let d4 = PI * self.delta.powi(4);
+        (
+            d4 * (o.cn - o.cs) / 30.0,
+            d4 * (2.0 * o.cn + 3.0 * o.cs) / 60.0,
+        )
+    }
+
+    fn drift(&self, a: &mut Motion6, h: f64) {
+        for k in 0..3 {
+            a.pos[k] += h * a.vel[k];
+        }
+        let w = a.angular_velocity;
+        let q = product(&quaternion([h * w[0], h * w[1], h * w[2]]), &a.orientation);
+        let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+        a.orientation = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
+        a.rotation = rotation_vector(&a.orientation);
+    }
+
+    #[inline(always)]
+    fn pair(
+        &self,
+        law: &Law,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+        _: &mut (),
+    ) -> Option<(Force6, Force6)> {
+        let (y, r, s, di, dj, g) = Self::kinematics(i, j, geom);
+        if s > law.tensile || s < law.compressive {
+            return None;
+        }
+        let v = geom.beta * i.volume * j.volume;
+        let axial = law.a * s / r;
+        let f = [
+            v * (axial * y[0] + law.cs * g[0]),
+            v * (axial * y[1] + law.cs * g[1]),
+            v * (axial * y[2] + law.cs * g[2]),
+        ];
+        let half = 0.5 * geom.length * law.cs * v;
+        let (mi, mj) = (cross(di, g), cross(dj, g));
+        let (sin_phi, _) = relative(&i.alter.orientation, &j.alter.orientation);
+        let k = law.kappa * v;
+        Some((
+            Force6 {
+                force: f,
+                moment: [
+                    half * mi[0] + k * sin_phi[0],
+                    half * mi[1] + k * sin_phi[1],
+                    half * mi[2] + k * sin_phi[2],
+                ],
+            },
+            Force6 {
+                force: [-f[0], -f[1], -f[2]],
+                moment: [
+                    half * mj[0] - k * sin_phi[0],
+                    half * mj[1] - k * sin_phi[1],
+                    half * mj[2] - k * sin_phi[2],
+                ],
+            },
+        ))
+    }
+
+    fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {
+        let (_, _, s, _, _, g) = Self::kinematics(i, j, geom);
+        let (_, one_minus_cos) = relative(&i.alter.orientation, &j.alter.orientation);
+        let g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        geom.beta
+            * i.volume
+            * j.volume
+            * (0.5 * geom.length * (law.a * s * s + law.cs * g2) + law.kappa * one_minus_cos)
+    }
+
+    fn at_rest(&self, a: &mut Motion6) {
+        a.orientation = [1.0, 0.0, 0.0, 0.0];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quaternions_round_trip() {
+        let r = [0.3, -1.2, 0.7];
+        let back = rotation_vector(&quaternion(r));
+        for k in 0..3 {
+            assert!((back[k] - r[k]).abs() < 1e-14);
+        }
+        // A quarter turn about z takes x to y.
+        let q = quaternion([0.0, 0.0, PI / 2.0]);
+        let v = rotate(&q, [1.0, 0.0, 0.0]);
+        assert!((v[0]).abs() < 1e-15 && (v[1] - 1.0).abs() < 1e-15);
+        // Relative rotation of identity to q: sin|φ| φ̂ = (0, 0, 1), 1 − cos|φ| = 1.
+        let (s, c) = relative(&[1.0, 0.0, 0.0, 0.0], &q);
+        assert!((s[2] - 1.0).abs() < 1e-15 && (c - 1.0).abs() < 1e-15);
+    }
+}
