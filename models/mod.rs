@@ -7,10 +7,12 @@ pub mod concrete;
 pub mod lps;
 pub mod micropolar;
 pub mod pmb;
+pub mod thermal;
 
 crate::model_registry! {
     pmb::Pmb,
     concrete::Concrete,
     lps::Lps,
     micropolar::Micropolar,
+    thermal::Thermal,
 }
