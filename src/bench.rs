@@ -38,7 +38,9 @@ pub struct BenchOptions {
 
 const SPACING: f64 = 0.001;
 
-/// The standard scene as a deck, for `model` ("pmb" or "concrete").
+/// The standard scene as a deck, for `model` (every model in `models/`): the same block, the
+/// same stiffness (K of the PMB micromodulus) and critical stretch, and for LPS the peer's
+/// moduli and influence function (LAMMPS `peri/lps`: K = G = 14.9 GPa, ω = 1/r).
 pub fn standard_deck(model: &str, n: usize, steps: u64) -> Result<String, String> {
     let h = SPACING;
     let hi = (n as f64 + 0.5) * h;
@@ -52,11 +54,26 @@ pub fn standard_deck(model: &str, n: usize, steps: u64) -> Result<String, String
             let e = 1.6863e22 * std::f64::consts::PI * 0.003015f64.powi(4) * 0.5 / 6.0;
             format!("kind = \"concrete\"\ndensity = 2200\nyoungs_modulus = {e:e}\npoisson_ratio = 0.25\ntensile_stretch = 0.0005\ncompressive_stretch = -0.005\n")
         }
+        "lps" => "density = 2200\nbulk_modulus = 14.9e9\npoisson_ratio = 0.125\ncritical_stretch = 0.0005\n[model.options]\ninfluence = \"inverse_length\"\n".to_string(),
+        // ν = 0.2 so that the shear part (c_s > 0) and its moments are computed.
+        "micropolar" => {
+            let k = 1.6863e22 * std::f64::consts::PI * 0.003015f64.powi(4) / 18.0;
+            format!("density = 2200\nyoungs_modulus = {:e}\npoisson_ratio = 0.2\ncritical_stretch = 0.0005\n", 3.0 * k * (1.0 - 0.4))
+        }
+        "thermal" => {
+            let k = 1.6863e22 * std::f64::consts::PI * 0.003015f64.powi(4) / 18.0;
+            format!("density = 2200\nbulk_modulus = {k:e}\ncritical_stretch = 0.0005\nthermal_conductivity = 2.0\nspecific_heat = 900.0\nthermal_expansion = 1e-5\n")
+        }
         other => {
             return Err(format!(
-                "no standard bench scene for model '{other}' (use pmb or concrete)"
+                "no standard bench scene for model '{other}' (use pmb, concrete, lps, micropolar or thermal)"
             ))
         }
+    };
+    // Model options come after the material table in TOML, so they close the deck's [model].
+    let (material, options) = match material.split_once("[model.options]") {
+        Some((m, o)) => (m.to_string(), format!("[model.options]{o}")),
+        None => (material, String::new()),
     };
     Ok(format!(
         r#"title = "standard benchmark scene ({model})"
@@ -64,6 +81,7 @@ units = "SI"
 [model]
 name = "{model}"
 horizon = 0.003015
+{options}
 [lattice]
 spacing = {h:e}
 origin = [{o:e}, {o:e}, {o:e}]
@@ -76,7 +94,7 @@ min = [{o:e}, {o:e}, {o:e}]
 max = [{hi:e}, {hi:e}, {hi:e}]
 [time]
 steps = {steps}
-dt = 1e-7
+dt = {dt:e}
 force_dt = true
 [[initial]]
 region = {{ shape = "slab", axis = "z", from = {top:e}, to = 1.0 }}
@@ -87,10 +105,15 @@ history_every = {steps}
 "#,
         o = -0.5 * h,
         top = (n as f64 - 2.5) * h,
+        // Rotations bound micropolar's step below the peer's 1e-7 s (THEORY.md §4).
+        dt = if model == "micropolar" { 5e-8 } else { 1e-7 },
     ))
 }
 
 /// The LAMMPS input of the peer benchmark (`shared/bench/lammps_pmb.in`).
+/// The LAMMPS input of the LPS peer benchmark (`shared/bench/lammps_lps.in`).
+const LAMMPS_LPS: &str = "units si\nboundary s s s\natom_style peri\natom_modify map array\nlattice sc 0.001\nregion box block 0 ${n} 0 ${n} 0 ${n}\ncreate_box 1 box\ncreate_atoms 1 region box\npair_style peri/lps\npair_coeff * * 14.9e9 14.9e9 0.0030150 0.0005 0.25\nset group all density 2200\nset group all volume 1.0e-9\nvelocity all set 0.0 0.0 0.0 sum no units box\nregion top block INF INF INF INF $(v_n-2) ${n} units lattice\ngroup top region top\nvelocity top set 0.0 0.0 1.0 sum no units box\nneighbor 0.0010 bin\nfix 1 all nve\ntimestep 1.0e-7\nthermo 100\nrun ${steps}\n";
+
 const LAMMPS_PMB: &str = "units si\nboundary s s s\natom_style peri\natom_modify map array\nlattice sc 0.001\nregion box block 0 ${n} 0 ${n} 0 ${n}\ncreate_box 1 box\ncreate_atoms 1 region box\npair_style peri/pmb\npair_coeff * * 1.6863e22 0.0030150 0.0005 0.25\nset group all density 2200\nset group all volume 1.0e-9\nvelocity all set 0.0 0.0 0.0 sum no units box\nregion top block INF INF INF INF $(v_n-2) ${n} units lattice\ngroup top region top\nvelocity top set 0.0 0.0 1.0 sum no units box\nneighbor 0.0010 bin\nfix 1 all nve\ntimestep 1.0e-7\nthermo 100\nrun ${steps}\n";
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -130,9 +153,10 @@ pub fn run(opts: &BenchOptions) -> Result<String, String> {
                     if t == 1 {
                         let _ = writeln!(
                             out,
-                            "bench ratio lammps/pdq={:.2} (model={} vs peri/pmb, 1 core each)",
+                            "bench ratio lammps/pdq={:.2} (model={} vs peri/{}, 1 core each)",
                             theirs / ours,
-                            opts.model
+                            opts.model,
+                            if opts.model == "lps" { "lps" } else { "pmb" }
                         );
                     }
                 }
@@ -423,8 +447,14 @@ fn peer(opts: &BenchOptions, ranks: usize) -> Result<Result<(String, f64), Strin
     let lmp = std::env::var("PDQ_LMP").unwrap_or_else(|_| "lmp".into());
     let dir = std::env::temp_dir().join(format!("pdq-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let input = dir.join("lammps_pmb.in");
-    std::fs::write(&input, LAMMPS_PMB).map_err(|e| e.to_string())?;
+    // LPS is compared with peri/lps, every other model with peri/pmb.
+    let (name, text) = if opts.model == "lps" {
+        ("lammps_lps.in", LAMMPS_LPS)
+    } else {
+        ("lammps_pmb.in", LAMMPS_PMB)
+    };
+    let input = dir.join(name);
+    std::fs::write(&input, text).map_err(|e| e.to_string())?;
     let mut cmd = if ranks > 1 {
         let mut c = mpirun(ranks);
         c.arg(&lmp);
@@ -434,7 +464,7 @@ fn peer(opts: &BenchOptions, ranks: usize) -> Result<Result<(String, f64), Strin
     };
     let output = cmd
         .current_dir(&dir)
-        .args(["-in", "lammps_pmb.in", "-var", "n"])
+        .args(["-in", name, "-var", "n"])
         .arg(opts.n.to_string())
         .args(["-var", "steps"])
         .arg(opts.steps.to_string())
