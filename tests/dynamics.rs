@@ -55,8 +55,8 @@ fn energy_drift<M: Model>(text: &str, v: f64, steps: usize) -> f64 {
         let vel = s.sim.particles.velocity_mut(i);
         vel[0] = v * phase(0);
         vel[1] = 0.5 * v * phase(0) * phase(2);
-        for k in 3..n2 {
-            vel[k] = v / 7e-3 * phase(k - 3);
+        for (k, w) in vel.iter_mut().enumerate().take(n2).skip(3) {
+            *w = v / 7e-3 * phase(k - 3);
         }
     }
     s.sim.compute_forces();
@@ -168,8 +168,8 @@ fn a_free_spinning_micropolar_body_keeps_its_angular_momentum() {
             omega[2] * r[0] - omega[0] * r[2] + 0.01 * noise(i, 1),
             omega[0] * r[1] - omega[1] * r[0] + 0.01 * noise(i, 2),
         ];
-        for k in 0..3 {
-            a.angular_velocity[k] = omega[k] * (1.0 + 0.1 * noise(i, k + 3));
+        for (k, (w, o)) in a.angular_velocity.iter_mut().zip(omega).enumerate() {
+            *w = o * (1.0 + 0.1 * noise(i, k + 3));
         }
     }
     s.sim.compute_forces();
