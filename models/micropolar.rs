@@ -27,13 +27,17 @@ use std::f64::consts::PI;
 
 crate::attributes! {
     /// Position, rotation vector, their velocities, then the orientation quaternion (w, x, y, z)
-    /// that the rotation vector summarizes.
+    /// that the rotation vector summarizes, and the same orientation as a rotation matrix (row
+    /// major). The quaternion is what is integrated; the matrix is derived from it at every
+    /// drift because the bond loop turns a vector per bond, which costs a matrix 15 flops and a
+    /// quaternion about 30.
     pub struct Motion6 {
         pub pos: [f64; 3],
         pub rotation: [f64; 3],
         pub vel: [f64; 3],
         pub angular_velocity: [f64; 3],
         pub orientation: [f64; 4],
+        pub frame: [f64; 9],
     }
 }
 
@@ -82,17 +86,29 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-/// v rotated by the unit quaternion q = (w, u): v + 2w u×v + 2u×(u×v).
-#[inline(always)]
-fn rotate(q: &[f64; 4], v: [f64; 3]) -> [f64; 3] {
-    let u = [q[1], q[2], q[3]];
-    let t = cross(u, v);
-    let t = [2.0 * t[0], 2.0 * t[1], 2.0 * t[2]];
-    let c = cross(u, t);
+/// The rotation matrix (row major) of the unit quaternion q.
+fn matrix(q: &[f64; 4]) -> [f64; 9] {
+    let [w, x, y, z] = *q;
     [
-        v[0] + q[0] * t[0] + c[0],
-        v[1] + q[0] * t[1] + c[1],
-        v[2] + q[0] * t[2] + c[2],
+        1.0 - 2.0 * (y * y + z * z),
+        2.0 * (x * y - w * z),
+        2.0 * (x * z + w * y),
+        2.0 * (x * y + w * z),
+        1.0 - 2.0 * (x * x + z * z),
+        2.0 * (y * z - w * x),
+        2.0 * (x * z - w * y),
+        2.0 * (y * z + w * x),
+        1.0 - 2.0 * (x * x + y * y),
+    ]
+}
+
+/// R v.
+#[inline(always)]
+fn apply(r: &[f64; 9], v: [f64; 3]) -> [f64; 3] {
+    [
+        r[0] * v[0] + r[1] * v[1] + r[2] * v[2],
+        r[3] * v[0] + r[4] * v[1] + r[5] * v[2],
+        r[6] * v[0] + r[7] * v[1] + r[8] * v[2],
     ]
 }
 
@@ -147,32 +163,30 @@ fn quaternion(r: [f64; 3]) -> [f64; 4] {
 }
 
 impl Micropolar {
-    /// The bond's strain measures: (y, |y|, s, d_i, d_j, g).
+    /// The bond's strain measures, scaled by L to save divisions: (y, |y|, 1/(L|y|), s, D_i,
+    /// D_j, G) with D = Q ξ and G = y − ½(D_i + D_j) = L g.
     #[inline(always)]
     #[allow(clippy::type_complexity)]
     fn kinematics(
         i: &Side<Self>,
         j: &Side<Self>,
         geom: &BondGeom,
-    ) -> ([f64; 3], f64, f64, [f64; 3], [f64; 3], [f64; 3]) {
+    ) -> ([f64; 3], f64, f64, f64, [f64; 3], [f64; 3], [f64; 3]) {
         let (a, b) = (i.pos(), j.pos());
         let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
         let l = geom.length;
-        let inv_l = 1.0 / l;
-        let n0 = [
-            (j.x0[0] - i.x0[0]) * inv_l,
-            (j.x0[1] - i.x0[1]) * inv_l,
-            (j.x0[2] - i.x0[2]) * inv_l,
-        ];
-        let di = rotate(&i.alter.orientation, n0);
-        let dj = rotate(&j.alter.orientation, n0);
+        // One division per bond: 1/L = r/(L r).
+        let inv_lr = 1.0 / (l * r);
+        let xi = [j.x0[0] - i.x0[0], j.x0[1] - i.x0[1], j.x0[2] - i.x0[2]];
+        let di = apply(&i.alter.frame, xi);
+        let dj = apply(&j.alter.frame, xi);
         let g = [
-            y[0] * inv_l - 0.5 * (di[0] + dj[0]),
-            y[1] * inv_l - 0.5 * (di[1] + dj[1]),
-            y[2] * inv_l - 0.5 * (di[2] + dj[2]),
+            y[0] - 0.5 * (di[0] + dj[0]),
+            y[1] - 0.5 * (di[1] + dj[1]),
+            y[2] - 0.5 * (di[2] + dj[2]),
         ];
-        (y, r, (r - l) * inv_l, di, dj, g)
+        (y, r, inv_lr, (r - l) * r * inv_lr, di, dj, g)
     }
 }
 
@@ -314,6 +328,7 @@ impl Model for Micropolar {
         let q = product(&quaternion([h * w[0], h * w[1], h * w[2]]), &a.orientation);
         let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
         a.orientation = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
+        a.frame = matrix(&a.orientation);
         a.rotation = rotation_vector(&a.orientation);
     }
 
@@ -326,45 +341,52 @@ impl Model for Micropolar {
         geom: &BondGeom,
         _: &mut (),
     ) -> Option<(Force6, Force6)> {
-        let (y, r, s, di, dj, g) = Self::kinematics(i, j, geom);
+        let (y, r, inv_lr, s, di, dj, g) = Self::kinematics(i, j, geom);
         if s > law.tensile || s < law.compressive {
             return None;
         }
+        // With G = L g and D = L d: f = v[(c_n − c_s) s y/|y| + c_s G/L] and
+        // M_i = ½L c_s v d_i × g = (c_s v/(2L)) D_i × G.
         let v = geom.beta * i.volume * j.volume;
-        let axial = law.a * s / r;
+        // y/|y| = L y/(L|y|) and 1/L = |y|/(L|y|).
+        let axial = v * law.a * s * geom.length * inv_lr;
+        let shear = v * law.cs * r * inv_lr;
         let f = [
-            v * (axial * y[0] + law.cs * g[0]),
-            v * (axial * y[1] + law.cs * g[1]),
-            v * (axial * y[2] + law.cs * g[2]),
+            axial * y[0] + shear * g[0],
+            axial * y[1] + shear * g[1],
+            axial * y[2] + shear * g[2],
         ];
-        let half = 0.5 * geom.length * law.cs * v;
-        let (mi, mj) = (cross(di, g), cross(dj, g));
-        let (sin_phi, _) = relative(&i.alter.orientation, &j.alter.orientation);
-        let k = law.kappa * v;
+        let half = 0.5 * shear;
+        let hg = [half * g[0], half * g[1], half * g[2]];
+        let mut moment_i = cross(di, hg);
+        let mut moment_j = cross(dj, hg);
+        // κ_φ = 0 (the default) skips the relative rotation; one law per pass keeps the branch
+        // predictable.
+        if law.kappa != 0.0 {
+            let (sin_phi, _) = relative(&i.alter.orientation, &j.alter.orientation);
+            let k = law.kappa * v;
+            for c in 0..3 {
+                moment_i[c] += k * sin_phi[c];
+                moment_j[c] -= k * sin_phi[c];
+            }
+        }
         Some((
             Force6 {
                 force: f,
-                moment: [
-                    half * mi[0] + k * sin_phi[0],
-                    half * mi[1] + k * sin_phi[1],
-                    half * mi[2] + k * sin_phi[2],
-                ],
+                moment: moment_i,
             },
             Force6 {
                 force: [-f[0], -f[1], -f[2]],
-                moment: [
-                    half * mj[0] - k * sin_phi[0],
-                    half * mj[1] - k * sin_phi[1],
-                    half * mj[2] - k * sin_phi[2],
-                ],
+                moment: moment_j,
             },
         ))
     }
 
     fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {
-        let (_, _, s, _, _, g) = Self::kinematics(i, j, geom);
+        let (_, _, _, s, _, _, big_g) = Self::kinematics(i, j, geom);
         let (_, one_minus_cos) = relative(&i.alter.orientation, &j.alter.orientation);
-        let g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        let l2 = geom.length * geom.length;
+        let g2 = (big_g[0] * big_g[0] + big_g[1] * big_g[1] + big_g[2] * big_g[2]) / l2;
         geom.beta
             * i.volume
             * j.volume
@@ -373,6 +395,7 @@ impl Model for Micropolar {
 
     fn at_rest(&self, a: &mut Motion6) {
         a.orientation = [1.0, 0.0, 0.0, 0.0];
+        a.frame = matrix(&a.orientation);
     }
 }
 
@@ -389,7 +412,7 @@ mod tests {
         }
         // A quarter turn about z takes x to y.
         let q = quaternion([0.0, 0.0, PI / 2.0]);
-        let v = rotate(&q, [1.0, 0.0, 0.0]);
+        let v = apply(&matrix(&q), [1.0, 0.0, 0.0]);
         assert!((v[0]).abs() < 1e-15 && (v[1] - 1.0).abs() < 1e-15);
         // Relative rotation of identity to q: sin|φ| φ̂ = (0, 0, 1), 1 − cos|φ| = 1.
         let (s, c) = relative(&[1.0, 0.0, 0.0, 0.0], &q);

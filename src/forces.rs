@@ -15,31 +15,95 @@ pub fn state_pass<M: Model>(model: &M, p: &mut Particles<M>, bonds: &BondList<M:
     if <M::State as Attributes>::LEN == 0 {
         return;
     }
-    for s in p.state.iter_mut() {
+    match single_material(&p.material) {
+        Some(m) => {
+            let law = model.law(m, m);
+            state_loop(model, p, bonds, |_, _| law)
+        }
+        None => state_loop(model, p, bonds, |a, b| model.law(a, b)),
+    }
+}
+
+/// The state pass's bond loop, shaped like [`pair_loop`] (see the comments there).
+#[inline(always)]
+fn state_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
+    model: &M,
+    p: &mut Particles<M>,
+    bonds: &BondList<M::Bond>,
+    law_of: L,
+) {
+    let Particles {
+        n_owned,
+        x0,
+        volume,
+        material,
+        fixed,
+        alter,
+        state,
+        ..
+    } = p;
+    // Sums go straight into `state` (no buffer per step); the sides the model sees carry a
+    // zero state, since a state is not an input to its own pass.
+    for s in state.iter_mut() {
         *s = M::State::default();
     }
-    // Sums go straight into `p.state` (no buffer per step); the sides the model sees carry a
-    // zero state, since a state is not an input to its own pass.
     let zero = M::State::default();
-    for i in 0..p.n_owned {
-        for b in bonds.offsets[i] as usize..bonds.offsets[i + 1] as usize {
-            if bonds.broken[b] {
+    let n = x0.len();
+    assert!(
+        *n_owned <= n
+            && bonds.offsets.len() == *n_owned + 1
+            && [
+                volume.len(),
+                material.len(),
+                fixed.len(),
+                alter.len(),
+                state.len()
+            ]
+            .iter()
+            .all(|&l| l == n)
+            && (bonds.max_partner() < n || bonds.offsets.last() == Some(&0)),
+        "bond list does not match the particle store"
+    );
+    let partners = bonds.partners();
+    for i in 0..*n_owned {
+        let (x0_i, alter_i, fixed_i) = (x0[i], alter[i], fixed[i]);
+        let side_i = Side::<M> {
+            x0: &x0_i,
+            volume: volume[i],
+            material: material[i],
+            alter: &alter_i,
+            fixed: &fixed_i,
+            state: &zero,
+        };
+        let mut si = M::State::default();
+        let range = bonds.offsets[i] as usize..bonds.offsets[i + 1] as usize;
+        let (partner, geom) = (&partners[range.clone()], &bonds.geom[range.clone()]);
+        let (broken, history) = (&bonds.broken[range.clone()], &bonds.history[range]);
+        for k in 0..partner.len() {
+            if broken[k] {
                 continue;
             }
-            let j = bonds.partners()[b] as usize;
-            let law = model.law(p.material[i], p.material[j]);
-            let side = |k: usize| Side::<M> {
-                x0: &p.x0[k],
-                volume: p.volume[k],
-                material: p.material[k],
-                alter: &p.alter[k],
-                fixed: &p.fixed[k],
-                state: &zero,
+            let j = partner[k] as usize;
+            // SAFETY: as in `pair_loop`: partners are below the store's length, checked above.
+            let (side_j, sj) = unsafe {
+                (
+                    Side::<M> {
+                        x0: x0.get_unchecked(j),
+                        volume: *volume.get_unchecked(j),
+                        material: *material.get_unchecked(j),
+                        alter: alter.get_unchecked(j),
+                        fixed: fixed.get_unchecked(j),
+                        state: &zero,
+                    },
+                    state.get_unchecked_mut(j),
+                )
             };
-            let (si, sj) = model.state(&law, &side(i), &side(j), &bonds.geom[b], &bonds.history[b]);
-            add_assign(&mut p.state[i], &si);
-            add_assign(&mut p.state[j], &sj);
+            let law = law_of(side_i.material, side_j.material);
+            let (a, b) = model.state(&law, &side_i, &side_j, &geom[k], &history[k]);
+            add_assign(&mut si, &a);
+            add_assign(sj, &b);
         }
+        add_assign(&mut state[i], &si);
     }
 }
 

@@ -325,7 +325,9 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
         (Self::State::default(), Self::State::default())
     }
 
-    /// Turns a particle's summed state into its final value (e.g. θ = 3/m·Σ…).
+    /// Turns a particle's summed state into its final value (e.g. θ = 3/m·Σ…); it may also
+    /// fill fields the pair pass wants per particle (LPS keeps 1/m there), which the sums leave
+    /// at zero.
     fn finish_state(&self, _state: &mut Self::State, _fixed: &Self::Fixed) {}
 
     /// Generalized forces on both ends of an intact bond, already multiplied by both volumes.
