@@ -44,12 +44,18 @@ fn read_final(dir: &Path) -> (Vec<[f64; 3]>, Vec<(u32, u32)>) {
 }
 
 fn mpirun(np: usize, extra: &[&str], dir: &Path) {
+    mpirun_deck(np, Path::new(DECK), extra, dir)
+}
+
+fn mpirun_deck(np: usize, deck: &Path, extra: &[&str], dir: &Path) {
     let out = Command::new("mpirun")
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .args(["--oversubscribe", "-np", &np.to_string()])
         .arg(env!("CARGO_BIN_EXE_pdq"))
-        .args(["run", DECK, "--quiet", "--output"])
+        .arg("run")
+        .arg(deck)
+        .args(["--quiet", "--output"])
         .arg(dir)
         .args(extra)
         .output()
@@ -121,6 +127,49 @@ fn mpi_ranks_agree_with_threads() {
     }
     let _ = std::fs::remove_dir_all(threads_dir);
     let _ = std::fs::remove_dir_all(solo);
+}
+
+#[test]
+fn lps_micropolar_and_thermal_ranks_agree_with_threads() {
+    for model in ["lps", "micropolar", "thermal"] {
+        let deck_dir = out_dir(&format!("{model}-deck"));
+        std::fs::create_dir_all(&deck_dir).unwrap();
+        let deck_path = deck_dir.join(format!("{model}_pull.toml"));
+        std::fs::write(&deck_path, common::model_pull_deck(model)).unwrap();
+        let scene = deck::load(&deck_path).unwrap();
+        let threads_dir = out_dir(&format!("{model}-threads"));
+        let reference = run(
+            &scene,
+            &RunOptions {
+                output: Some(threads_dir.clone()),
+                quiet: true,
+                threads: Some(4),
+                procs: Some(Procs::Given([2, 2, 1])),
+                walls: Some(Walls::Whole),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        assert!(reference.broken > 50, "{model}: the deck must crack");
+        let (ref_pos, ref_broken) = read_final(&threads_dir);
+        for (np, extra) in [
+            (2, vec![]),
+            (4, vec!["--procs", "1x2x2", "--walls", "trimmed"]),
+        ] {
+            let dir = out_dir(&format!("{model}-np{np}"));
+            mpirun_deck(np, &deck_path, &extra, &dir);
+            let (pos, broken) = read_final(&dir);
+            let d = max_relative_difference(&ref_pos, &pos);
+            eprintln!(
+                "{model}: mpirun -np {np} {extra:?}: max relative position difference {d:.2e}"
+            );
+            assert!(d <= 1e-12, "{model} -np {np}: positions differ by {d:e}");
+            assert_eq!(broken, ref_broken, "{model} -np {np}: broken bonds differ");
+            let _ = std::fs::remove_dir_all(dir);
+        }
+        let _ = std::fs::remove_dir_all(threads_dir);
+        let _ = std::fs::remove_dir_all(deck_dir);
+    }
 }
 
 #[test]

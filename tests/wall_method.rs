@@ -616,3 +616,61 @@ fn shuffling_on_a_short_periodic_axis_finds_the_right_images() {
         assert!(d <= 1e-12, "{procs:?}: positions differ by {d:e}");
     }
 }
+
+#[test]
+fn lps_micropolar_and_thermal_results_do_not_depend_on_the_layout() {
+    for model in ["lps", "micropolar", "thermal"] {
+        let text = common::model_pull_deck(model);
+        let (reference, header, ref_rows) = run_with_history(&text, [1, 1, 1], Walls::Whole);
+        assert!(
+            reference.broken > 50,
+            "{model}: the deck must crack within 500 steps ({} broken)",
+            reference.broken
+        );
+        for (procs, walls) in [
+            ([2, 1, 1], Walls::Whole),
+            ([2, 2, 2], Walls::Trimmed),
+            ([3, 2, 1], Walls::Whole),
+        ] {
+            let (s, h, rows) = run_with_history(&text, procs, walls);
+            let d = max_relative_difference(&reference.positions, &s.positions);
+            eprintln!(
+                "{model} {procs:?} {}: max relative position difference {d:.2e}, {} broken",
+                walls.name(),
+                s.broken
+            );
+            assert!(d <= 1e-12, "{model} {procs:?}: positions differ by {d:e}");
+            assert_eq!(s.broken_pairs, reference.broken_pairs, "{model} {procs:?}");
+            // Every history column (energies, reactions: moments, the cold support's heat)
+            // agrees to round-off, relative to the column's largest value; a support whose
+            // reaction is round-off zero (a detached end) is measured against all reactions.
+            assert_eq!(h, header);
+            assert_eq!(rows.len(), ref_rows.len());
+            let column_max = |k: usize| {
+                ref_rows
+                    .iter()
+                    .fold(0.0f64, |m, r: &Vec<f64>| m.max(r[k].abs()))
+            };
+            let reactions = (0..header.len())
+                .filter(|&k| header[k].starts_with("reaction_"))
+                .map(column_max)
+                .fold(0.0, f64::max);
+            for k in 0..header.len() {
+                let scale = if header[k].starts_with("reaction_") {
+                    column_max(k).max(1e-6 * reactions)
+                } else {
+                    column_max(k)
+                };
+                for (a, b) in rows.iter().zip(&ref_rows) {
+                    assert!(
+                        (a[k] - b[k]).abs() <= 1e-9 * scale,
+                        "{model} {procs:?}: history column {} differs: {} vs {}",
+                        header[k],
+                        a[k],
+                        b[k]
+                    );
+                }
+            }
+        }
+    }
+}

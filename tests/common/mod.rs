@@ -10,3 +10,39 @@ pub fn max_relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
         .fold(0.0, f64::max)
         / scale
 }
+
+/// The notched-pull deck of the layout tests (`tests/decks/notched_pull.toml`, PMB) made over
+/// for another model: the state pass (`lps`), rotations with a relative-rotation stiffness
+/// (`micropolar`), or heat generated in one slab, held cold in another and conducted across
+/// procCube faces into thermal expansion (`thermal`). Each still cracks within its 500 steps.
+#[allow(dead_code)]
+pub fn model_pull_deck(model: &str) -> String {
+    let base = include_str!("../decks/notched_pull.toml");
+    let rock =
+        "density = \"2200 kg/m^3\"\nbulk_modulus = \"14.9 GPa\"\ncritical_stretch = 0.0005\n";
+    assert!(base.contains(rock) && base.contains("name = \"pmb\""));
+    let (material, extra) = match model {
+        "lps" => (
+            "density = \"2200 kg/m^3\"\nbulk_modulus = \"14.9 GPa\"\npoisson_ratio = 0.3\ncritical_stretch = 0.0005\n",
+            "",
+        ),
+        "micropolar" => (
+            "density = \"2200 kg/m^3\"\nyoungs_modulus = \"26.8 GPa\"\npoisson_ratio = 0.2\ncritical_stretch = 0.0005\n",
+            "[model.options]\nkappa = 0.05\n",
+        ),
+        "thermal" => (
+            "density = \"2200 kg/m^3\"\nbulk_modulus = \"14.9 GPa\"\ncritical_stretch = 0.0005\nthermal_conductivity = 2.0\nspecific_heat = 900.0\nthermal_expansion = 1e-5\n",
+            "[[load]]\nname = \"heater\"\nregion = { shape = \"slab\", axis = \"y\", from = \"0 mm\", to = \"2 mm\" }\nheat_source = 2e12\n[[boundary]]\nname = \"cold\"\nregion = { shape = \"box\", min = \"5 8 0 mm\", max = \"25 10 10 mm\" }\ntemperature = 0.0\n",
+        ),
+        other => panic!("no pull deck for model '{other}'"),
+    };
+    let text = base
+        .replace("name = \"pmb\"", &format!("name = \"{model}\""))
+        .replace(rock, material);
+    // `[model.options]` must follow `[model]`; the other additions go at the end.
+    if extra.starts_with("[model.options]") {
+        text.replace("[lattice]", &format!("{extra}[lattice]"))
+    } else {
+        format!("{text}{extra}")
+    }
+}
