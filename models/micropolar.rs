@@ -2,8 +2,9 @@
 //! rotation), a bond force and two unequal bond moments (THEORY.md §3, marked DERIVED there:
 //! energy equivalence, not a published law; docs/models.md lists what was verified).
 //!
-//! Each particle carries an orientation Q (a unit quaternion). For a bond of reference
-//! direction n₀ = ξ/L, current vector y and d_i = Q_i n₀:
+//! Each particle carries an orientation Q (a unit quaternion, integrated, and its rotation
+//! matrix, derived at every drift for the bond loop). For a bond of reference direction
+//! n₀ = ξ/L, current vector y and d_i = Q_i n₀:
 //!
 //! * s = (|y| − L)/L, g = y/L − ½(d_i + d_j) (g = s n + γ for small motion, with γ the
 //!   shear of THEORY.md §3), and φ the rotation from Q_i to Q_j;
@@ -77,15 +78,6 @@ pub struct Micropolar {
     spacing: f64,
 }
 
-#[inline(always)]
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 /// The rotation matrix (row major) of the unit quaternion q.
 fn matrix(q: &[f64; 4]) -> [f64; 9] {
     let [w, x, y, z] = *q;
@@ -99,16 +91,6 @@ fn matrix(q: &[f64; 4]) -> [f64; 9] {
         2.0 * (x * z - w * y),
         2.0 * (y * z + w * x),
         1.0 - 2.0 * (x * x + y * y),
-    ]
-}
-
-/// R v.
-#[inline(always)]
-fn apply(r: &[f64; 9], v: [f64; 3]) -> [f64; 3] {
-    [
-        r[0] * v[0] + r[1] * v[1] + r[2] * v[2],
-        r[3] * v[0] + r[4] * v[1] + r[5] * v[2],
-        r[6] * v[0] + r[7] * v[1] + r[8] * v[2],
     ]
 }
 
@@ -163,15 +145,17 @@ fn quaternion(r: [f64; 3]) -> [f64; 4] {
 }
 
 impl Micropolar {
-    /// The bond's strain measures, scaled by L to save divisions: (y, |y|, 1/(L|y|), s, D_i,
-    /// D_j, G) with D = Q ξ and G = y − ½(D_i + D_j) = L g.
+    /// The bond's strain measures, scaled by L to save divisions: (y, |y|, 1/(L|y|), s, D, G)
+    /// with D = Q ξ of both ends as pairs per component, `d[k] = [D_i[k], D_j[k]]` (the two
+    /// ends' arithmetic is the same, so pairs map onto two-lane vector instructions), and
+    /// G = y − ½(D_i + D_j) = L g.
     #[inline(always)]
     #[allow(clippy::type_complexity)]
     fn kinematics(
         i: &Side<Self>,
         j: &Side<Self>,
         geom: &BondGeom,
-    ) -> ([f64; 3], f64, f64, f64, [f64; 3], [f64; 3], [f64; 3]) {
+    ) -> ([f64; 3], f64, f64, f64, [[f64; 2]; 3], [f64; 3]) {
         let (a, b) = (i.pos(), j.pos());
         let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
@@ -179,14 +163,13 @@ impl Micropolar {
         // One division per bond: 1/L = r/(L r).
         let inv_lr = 1.0 / (l * r);
         let xi = [j.x0[0] - i.x0[0], j.x0[1] - i.x0[1], j.x0[2] - i.x0[2]];
-        let di = apply(&i.alter.frame, xi);
-        let dj = apply(&j.alter.frame, xi);
-        let g = [
-            y[0] - 0.5 * (di[0] + dj[0]),
-            y[1] - 0.5 * (di[1] + dj[1]),
-            y[2] - 0.5 * (di[2] + dj[2]),
-        ];
-        (y, r, inv_lr, (r - l) * r * inv_lr, di, dj, g)
+        let (ri, rj) = (&i.alter.frame, &j.alter.frame);
+        let d = [0, 1, 2].map(|k| {
+            let row = |m: &[f64; 9]| m[3 * k] * xi[0] + m[3 * k + 1] * xi[1] + m[3 * k + 2] * xi[2];
+            [row(ri), row(rj)]
+        });
+        let g = [0, 1, 2].map(|k| y[k] - 0.5 * (d[k][0] + d[k][1]));
+        (y, r, inv_lr, (r - l) * r * inv_lr, d, g)
     }
 }
 
@@ -341,7 +324,7 @@ impl Model for Micropolar {
         geom: &BondGeom,
         _: &mut (),
     ) -> Option<(Force6, Force6)> {
-        let (y, r, inv_lr, s, di, dj, g) = Self::kinematics(i, j, geom);
+        let (y, r, inv_lr, s, d, g) = Self::kinematics(i, j, geom);
         if s > law.tensile || s < law.compressive {
             return None;
         }
@@ -358,8 +341,16 @@ impl Model for Micropolar {
         ];
         let half = 0.5 * shear;
         let hg = [half * g[0], half * g[1], half * g[2]];
-        let mut moment_i = cross(di, hg);
-        let mut moment_j = cross(dj, hg);
+        // D × hG for both ends at once, component k from the pairs of components k+1, k+2.
+        let m = [0, 1, 2].map(|k| {
+            let (p, q) = ((k + 1) % 3, (k + 2) % 3);
+            [
+                d[p][0] * hg[q] - d[q][0] * hg[p],
+                d[p][1] * hg[q] - d[q][1] * hg[p],
+            ]
+        });
+        let mut moment_i = [m[0][0], m[1][0], m[2][0]];
+        let mut moment_j = [m[0][1], m[1][1], m[2][1]];
         // κ_φ = 0 (the default) skips the relative rotation; one law per pass keeps the branch
         // predictable.
         if law.kappa != 0.0 {
@@ -383,7 +374,7 @@ impl Model for Micropolar {
     }
 
     fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {
-        let (_, _, _, s, _, _, big_g) = Self::kinematics(i, j, geom);
+        let (_, _, _, s, _, big_g) = Self::kinematics(i, j, geom);
         let (_, one_minus_cos) = relative(&i.alter.orientation, &j.alter.orientation);
         let l2 = geom.length * geom.length;
         let g2 = (big_g[0] * big_g[0] + big_g[1] * big_g[1] + big_g[2] * big_g[2]) / l2;
@@ -412,7 +403,8 @@ mod tests {
         }
         // A quarter turn about z takes x to y.
         let q = quaternion([0.0, 0.0, PI / 2.0]);
-        let v = apply(&matrix(&q), [1.0, 0.0, 0.0]);
+        let m = matrix(&q);
+        let v = [m[0], m[3], m[6]];
         assert!((v[0]).abs() < 1e-15 && (v[1] - 1.0).abs() < 1e-15);
         // Relative rotation of identity to q: sin|φ| φ̂ = (0, 0, 1), 1 − cos|φ| = 1.
         let (s, c) = relative(&[1.0, 0.0, 0.0, 0.0], &q);
