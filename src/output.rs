@@ -59,6 +59,23 @@ enum Array<'a> {
     I32(&'a str, Vec<i32>),
 }
 
+/// One array per field of `records`, named as the model declares it.
+fn push_fields<A: Attributes>(arrays: &mut Vec<Array<'static>>, records: &[A]) {
+    let mut offset = 0;
+    for f in A::FIELDS {
+        let o = offset;
+        arrays.push(Array::F64(
+            f.name,
+            f.len,
+            records
+                .iter()
+                .flat_map(|r| r.as_slice()[o..o + f.len].to_vec())
+                .collect(),
+        ));
+        offset += f.len;
+    }
+}
+
 impl Frames {
     pub fn new(dir: &Path) -> std::io::Result<Frames> {
         std::fs::create_dir_all(dir.join("frames"))?;
@@ -93,30 +110,11 @@ impl Frames {
             ),
             Array::F64("volume", 1, p.volume[..n].to_vec()),
         ];
-        let mut offset = 0;
-        for f in <M::Alter as Attributes>::FIELDS {
-            let o = offset;
-            arrays.push(Array::F64(
-                f.name,
-                f.len,
-                (0..n)
-                    .flat_map(|i| p.alter[i].as_slice()[o..o + f.len].to_vec())
-                    .collect(),
-            ));
-            offset += f.len;
-        }
-        let mut offset = 0;
-        for f in <M::Force as Attributes>::FIELDS {
-            let o = offset;
-            arrays.push(Array::F64(
-                f.name,
-                f.len,
-                (0..n)
-                    .flat_map(|i| p.force[i].as_slice()[o..o + f.len].to_vec())
-                    .collect(),
-            ));
-            offset += f.len;
-        }
+        // Every declared per-particle attribute, by its declared name.
+        push_fields(&mut arrays, &p.alter[..n]);
+        push_fields(&mut arrays, &p.fixed[..n]);
+        push_fields(&mut arrays, &p.state[..n]);
+        push_fields(&mut arrays, &p.force[..n]);
         let points: Vec<f64> = (0..n).flat_map(|i| p.pos(i)).collect();
         write_vtu(&path, &points, &arrays)?;
         self.entries.push((time, name));

@@ -158,34 +158,49 @@ fn any_failed<M: Model>(cube: &mut Cube<M>, failed: bool) -> bool {
     Team::new(cube.sim.exchange.transport()).max(if failed { 1.0 } else { 0.0 }) > 0.0
 }
 
-/// Owned particles' global indices, alterable records and damage, gathered on the root.
+/// Owned particles' global indices, damage and every declared record (alterable, fixed, state,
+/// force), gathered on the root.
 fn gather_frame<M: Model>(cube: &mut Cube<M>, damage: &[f64], store: &mut Option<FrameStore<M>>) {
     // Reference positions travel too: a shuffle moves them with particles it wraps around a
     // periodic box.
-    let (la, lf) = (<M::Alter as Attributes>::LEN, <M::Force as Attributes>::LEN);
+    let lens = [
+        <M::Alter as Attributes>::LEN,
+        <M::Fixed as Attributes>::LEN,
+        <M::State as Attributes>::LEN,
+        <M::Force as Attributes>::LEN,
+    ];
+    let record = 5 + lens.iter().sum::<usize>();
     let p = &cube.sim.particles;
     let n = p.n_owned;
-    let mut mine = Vec::with_capacity(n * (5 + la + lf));
+    let mut mine = Vec::with_capacity(n * record);
     for (i, &d) in damage.iter().enumerate().take(n) {
         mine.push(p.gid[i] as f64);
         mine.push(d);
         mine.extend_from_slice(&p.x0[i]);
         mine.extend_from_slice(p.alter[i].as_slice());
+        mine.extend_from_slice(p.fixed[i].as_slice());
+        mine.extend_from_slice(p.state[i].as_slice());
         mine.extend_from_slice(p.force[i].as_slice());
     }
     let all = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&mine));
     if let (Some(all), Some(store)) = (all, store.as_mut()) {
         for bytes in all {
-            for rec in f64s(&bytes).chunks_exact(5 + la + lf) {
+            for rec in f64s(&bytes).chunks_exact(record) {
                 let g = store.index_of[rec[0] as usize] as usize;
                 store.damage[g] = rec[1];
                 store.particles.x0[g] = [rec[2], rec[3], rec[4]];
-                store.particles.alter[g]
-                    .as_mut_slice()
-                    .copy_from_slice(&rec[5..5 + la]);
-                store.particles.force[g]
-                    .as_mut_slice()
-                    .copy_from_slice(&rec[5 + la..]);
+                let sp = &mut store.particles;
+                let targets = [
+                    sp.alter[g].as_mut_slice(),
+                    sp.fixed[g].as_mut_slice(),
+                    sp.state[g].as_mut_slice(),
+                    sp.force[g].as_mut_slice(),
+                ];
+                let mut at = 5;
+                for (t, len) in targets.into_iter().zip(lens) {
+                    t.copy_from_slice(&rec[at..at + len]);
+                    at += len;
+                }
             }
         }
     }
