@@ -1,6 +1,7 @@
 //! Helpers shared by the integration tests that compare runs.
 
 /// Largest difference between two position sets, relative to the largest coordinate.
+#[allow(dead_code)]
 pub fn max_relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     assert_eq!(a.len(), b.len(), "different particle counts");
     let scale = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
