@@ -156,7 +156,7 @@ pub fn run(opts: &BenchOptions) -> Result<String, String> {
                             "bench ratio lammps/pdq={:.2} (model={} vs peri/{}, 1 core each)",
                             theirs / ours,
                             opts.model,
-                            if opts.model == "lps" { "lps" } else { "pmb" }
+                            peer_style(&opts.model)
                         );
                     }
                 }
@@ -440,15 +440,24 @@ pub fn hand_pmb_pass(
     }
 }
 
-/// LAMMPS `peri/pmb` on the same scene: `Ok(Ok((line, µs per particle-step)))`, or
+/// The LAMMPS pair style a model is compared with: `peri/lps` for LPS, `peri/pmb` for the rest.
+fn peer_style(model: &str) -> &'static str {
+    if model == "lps" {
+        "lps"
+    } else {
+        "pmb"
+    }
+}
+
+/// LAMMPS `peri/pmb` (or `peri/lps`) on the same scene: `Ok(Ok((line, µs per particle-step)))`, or
 /// `Ok(Err(line))` saying why it was skipped (no `lmp` on the PATH).
 #[allow(clippy::type_complexity)]
 fn peer(opts: &BenchOptions, ranks: usize) -> Result<Result<(String, f64), String>, String> {
     let lmp = std::env::var("PDQ_LMP").unwrap_or_else(|_| "lmp".into());
     let dir = std::env::temp_dir().join(format!("pdq-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    // LPS is compared with peri/lps, every other model with peri/pmb.
-    let (name, text) = if opts.model == "lps" {
+    let style = peer_style(&opts.model);
+    let (name, text) = if style == "lps" {
         ("lammps_lps.in", LAMMPS_LPS)
     } else {
         ("lammps_pmb.in", LAMMPS_PMB)
@@ -475,7 +484,7 @@ fn peer(opts: &BenchOptions, ranks: usize) -> Result<Result<(String, f64), Strin
         Ok(o) => o,
         Err(e) => {
             return Ok(Err(format!(
-                "bench peer=lammps-peri/pmb skipped: cannot run '{lmp}' ({e}); install it with apt-get install lammps\n"
+                "bench peer=lammps-peri/{style} skipped: cannot run '{lmp}' ({e}); install it with apt-get install lammps\n"
             )))
         }
     };
@@ -501,7 +510,7 @@ fn peer(opts: &BenchOptions, ranks: usize) -> Result<Result<(String, f64), Strin
     let us = 1e6 * secs / (atoms * steps);
     Ok(Ok((
         format!(
-            "bench peer=lammps-peri/pmb particles={atoms} steps={steps} threads=1 ranks={ranks} us_per_particle_step={us:.4}\n"
+            "bench peer=lammps-peri/{style} particles={atoms} steps={steps} threads=1 ranks={ranks} us_per_particle_step={us:.4}\n"
         ),
         us,
     )))

@@ -6,32 +6,15 @@
 
 use crate::attributes::{add_assign, Attributes};
 use crate::bonds::BondList;
-use crate::model::{Model, Side};
+use crate::model::{BondGeom, Model, Side};
 use crate::particles::Particles;
 
 /// Sums the model's per-particle state over intact bonds (owned and ghost ends). Does nothing,
 /// at compile time, for a model whose `State` is `()`.
-pub fn state_pass<M: Model>(model: &M, p: &mut Particles<M>, bonds: &BondList<M::Bond>) {
+pub fn state_pass<M: Model>(model: &M, p: &mut Particles<M>, bonds: &mut BondList<M::Bond>) {
     if <M::State as Attributes>::LEN == 0 {
         return;
     }
-    match single_material(&p.material) {
-        Some(m) => {
-            let law = model.law(m, m);
-            state_loop(model, p, bonds, |_, _| law)
-        }
-        None => state_loop(model, p, bonds, |a, b| model.law(a, b)),
-    }
-}
-
-/// The state pass's bond loop, shaped like [`pair_loop`] (see the comments there).
-#[inline(always)]
-fn state_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
-    model: &M,
-    p: &mut Particles<M>,
-    bonds: &BondList<M::Bond>,
-    law_of: L,
-) {
     let Particles {
         n_owned,
         x0,
@@ -44,66 +27,27 @@ fn state_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
     } = p;
     // Sums go straight into `state` (no buffer per step); the sides the model sees carry a
     // zero state, since a state is not an input to its own pass.
-    for s in state.iter_mut() {
-        *s = M::State::default();
-    }
     let zero = M::State::default();
-    let n = x0.len();
-    assert!(
-        *n_owned <= n
-            && bonds.offsets.len() == *n_owned + 1
-            && [
-                volume.len(),
-                material.len(),
-                fixed.len(),
-                alter.len(),
-                state.len()
-            ]
-            .iter()
-            .all(|&l| l == n)
-            && (bonds.max_partner() < n || bonds.offsets.last() == Some(&0)),
-        "bond list does not match the particle store"
-    );
-    let partners = bonds.partners();
-    for i in 0..*n_owned {
-        let (x0_i, alter_i, fixed_i) = (x0[i], alter[i], fixed[i]);
-        let side_i = Side::<M> {
-            x0: &x0_i,
-            volume: volume[i],
-            material: material[i],
-            alter: &alter_i,
-            fixed: &fixed_i,
-            state: &zero,
-        };
-        let mut si = M::State::default();
-        let range = bonds.offsets[i] as usize..bonds.offsets[i + 1] as usize;
-        let (partner, geom) = (&partners[range.clone()], &bonds.geom[range.clone()]);
-        let (broken, history) = (&bonds.broken[range.clone()], &bonds.history[range]);
-        for k in 0..partner.len() {
-            if broken[k] {
-                continue;
-            }
-            let j = partner[k] as usize;
-            // SAFETY: as in `pair_loop`: partners are below the store's length, checked above.
-            let (side_j, sj) = unsafe {
-                (
-                    Side::<M> {
-                        x0: x0.get_unchecked(j),
-                        volume: *volume.get_unchecked(j),
-                        material: *material.get_unchecked(j),
-                        alter: alter.get_unchecked(j),
-                        fixed: fixed.get_unchecked(j),
-                        state: &zero,
-                    },
-                    state.get_unchecked_mut(j),
-                )
-            };
-            let law = law_of(side_i.material, side_j.material);
-            let (a, b) = model.state(&law, &side_i, &side_j, &geom[k], &history[k]);
-            add_assign(&mut si, &a);
-            add_assign(sj, &b);
+    let ends = Ends {
+        n_owned: *n_owned,
+        x0,
+        volume,
+        material,
+        fixed,
+        alter,
+        state: ZeroState(&zero),
+    };
+    let visit = |law: &M::Law, i: &Side<M>, j: &Side<M>, geom: &BondGeom, bond: &mut M::Bond| {
+        Some(model.state(law, i, j, geom, bond))
+    };
+    match single_material(material) {
+        Some(m) => {
+            let law = model.law(m, m);
+            sweep(ends, bonds, state, |_, _| law, visit);
         }
-        add_assign(&mut state[i], &si);
+        None => {
+            sweep(ends, bonds, state, |a, b| model.law(a, b), visit);
+        }
     }
 }
 
@@ -124,29 +68,6 @@ pub fn pair_pass<M: Model>(
     p: &mut Particles<M>,
     bonds: &mut BondList<M::Bond>,
 ) -> usize {
-    // A scene of one material gets a loop with its law fixed: no material loads, no dispatch.
-    match single_material(&p.material) {
-        Some(m) => {
-            let law = model.law(m, m);
-            pair_loop(model, p, bonds, |_, _| law)
-        }
-        None => pair_loop(model, p, bonds, |a, b| model.law(a, b)),
-    }
-}
-
-/// The material of every particle, if there is only one.
-fn single_material(material: &[u16]) -> Option<u16> {
-    let first = *material.first()?;
-    material.iter().all(|&m| m == first).then_some(first)
-}
-
-#[inline(always)]
-fn pair_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
-    model: &M,
-    p: &mut Particles<M>,
-    bonds: &mut BondList<M::Bond>,
-    law_of: L,
-) -> usize {
     let Particles {
         n_owned,
         x0,
@@ -158,22 +79,130 @@ fn pair_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
         force,
         ..
     } = p;
-    for f in force.iter_mut() {
-        *f = M::Force::default();
+    let ends = Ends {
+        n_owned: *n_owned,
+        x0,
+        volume,
+        material,
+        fixed,
+        alter,
+        state: &state[..],
+    };
+    let visit = |law: &M::Law, i: &Side<M>, j: &Side<M>, geom: &BondGeom, bond: &mut M::Bond| {
+        model.pair(law, i, j, geom, bond)
+    };
+    // A scene of one material gets a loop with its law fixed: no material loads, no dispatch.
+    match single_material(material) {
+        Some(m) => {
+            let law = model.law(m, m);
+            sweep(ends, bonds, force, |_, _| law, visit)
+        }
+        None => sweep(ends, bonds, force, |a, b| model.law(a, b), visit),
+    }
+}
+
+/// The material of every particle, if there is only one.
+fn single_material(material: &[u16]) -> Option<u16> {
+    let first = *material.first()?;
+    material.iter().all(|&m| m == first).then_some(first)
+}
+
+/// Where the bond ends' states come from: the particles' own (the pair pass), or one zero state
+/// (the state pass, whose output the states are). A type each, so each loop is compiled for its
+/// source with no test per bond.
+trait States<S> {
+    fn len(&self) -> usize;
+    /// # Safety
+    /// `i < self.len()`.
+    unsafe fn get_unchecked(&self, i: usize) -> &S;
+    fn copy(&self, i: usize) -> S;
+}
+
+impl<S: Copy> States<S> for &[S] {
+    fn len(&self) -> usize {
+        <[S]>::len(self)
+    }
+    #[inline(always)]
+    unsafe fn get_unchecked(&self, i: usize) -> &S {
+        // SAFETY: the caller keeps i in bounds.
+        unsafe { <[S]>::get_unchecked(self, i) }
+    }
+    #[inline(always)]
+    fn copy(&self, i: usize) -> S {
+        self[i]
+    }
+}
+
+struct ZeroState<'a, S>(&'a S);
+
+impl<S: Copy> States<S> for ZeroState<'_, S> {
+    fn len(&self) -> usize {
+        usize::MAX
+    }
+    #[inline(always)]
+    unsafe fn get_unchecked(&self, _: usize) -> &S {
+        self.0
+    }
+    #[inline(always)]
+    fn copy(&self, _: usize) -> S {
+        *self.0
+    }
+}
+
+/// The per-particle data a bond loop reads.
+struct Ends<'a, M: Model, St> {
+    n_owned: usize,
+    x0: &'a [[f64; 3]],
+    volume: &'a [f64],
+    material: &'a [u16],
+    fixed: &'a [M::Fixed],
+    alter: &'a [M::Alter],
+    state: St,
+}
+
+/// The bond loop of both passes: every intact bond of every owned particle, once, from its
+/// owner. `visit` gives the two ends' contributions, added into `out` (zeroed first), or `None`
+/// to break the bond; returns how many broke.
+#[inline(always)]
+fn sweep<M, T, St, L, V>(
+    ends: Ends<'_, M, St>,
+    bonds: &mut BondList<M::Bond>,
+    out: &mut [T],
+    law_of: L,
+    mut visit: V,
+) -> usize
+where
+    M: Model,
+    T: Attributes,
+    St: States<M::State>,
+    L: Fn(u16, u16) -> M::Law,
+    V: FnMut(&M::Law, &Side<M>, &Side<M>, &BondGeom, &mut M::Bond) -> Option<(T, T)>,
+{
+    let Ends {
+        n_owned,
+        x0,
+        volume,
+        material,
+        fixed,
+        alter,
+        state,
+    } = ends;
+    for o in out.iter_mut() {
+        *o = T::default();
     }
     let bonds_max_partner = bonds.max_partner();
     let (offsets, partner, geom, broken, history) = bonds.parts_mut();
     let n = x0.len();
     assert!(
-        *n_owned <= n
-            && offsets.len() == *n_owned + 1
+        n_owned <= n
+            && offsets.len() == n_owned + 1
+            && state.len() >= n
             && [
                 volume.len(),
                 material.len(),
                 fixed.len(),
                 alter.len(),
-                state.len(),
-                force.len()
+                out.len()
             ]
             .iter()
             .all(|&l| l == n)
@@ -181,10 +210,11 @@ fn pair_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
         "bond list does not match the particle store"
     );
     let mut newly_broken = 0;
-    for i in 0..*n_owned {
-        // Local copies: the compiler cannot tell that the force stores below leave particle
-        // i's records alone, so references into the arrays would be reloaded on every bond.
-        let (x0_i, alter_i, fixed_i, state_i) = (x0[i], alter[i], fixed[i], state[i]);
+    for i in 0..n_owned {
+        // Local copies: the compiler cannot tell that the stores into `out` below leave
+        // particle i's records alone, so references into the arrays would be reloaded on
+        // every bond.
+        let (x0_i, alter_i, fixed_i, state_i) = (x0[i], alter[i], fixed[i], state.copy(i));
         let side_i = Side::<M> {
             x0: &x0_i,
             volume: volume[i],
@@ -193,7 +223,7 @@ fn pair_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
             fixed: &fixed_i,
             state: &state_i,
         };
-        let mut fi = M::Force::default();
+        let mut oi = T::default();
         let range = offsets[i] as usize..offsets[i + 1] as usize;
         let (partner, geom) = (&partner[range.clone()], &geom[range.clone()]);
         let (broken, history) = (&mut broken[range.clone()], &mut history[range]);
@@ -202,11 +232,11 @@ fn pair_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
                 continue;
             }
             let j = partner[k] as usize;
-            // SAFETY: every partner index is below the particle count (BondList keeps the partner
-            // list private and its maximum; checked above), and all
-            // per-particle arrays have that length. Unchecked access lets the compiler drop the
-            // loads of fields the model never reads, which bounds checks would keep alive.
-            let (side_j, fj) = unsafe {
+            // SAFETY: every partner index is below the particle count (BondList keeps the
+            // partner list private and its maximum; checked above), and all per-particle
+            // arrays have that length. Unchecked access lets the compiler drop the loads of
+            // fields the model never reads, which bounds checks would keep alive.
+            let (side_j, oj) = unsafe {
                 (
                     Side::<M> {
                         x0: x0.get_unchecked(j),
@@ -216,14 +246,14 @@ fn pair_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
                         fixed: fixed.get_unchecked(j),
                         state: state.get_unchecked(j),
                     },
-                    force.get_unchecked_mut(j),
+                    out.get_unchecked_mut(j),
                 )
             };
             let law = law_of(side_i.material, side_j.material);
-            match model.pair(&law, &side_i, &side_j, &geom[k], &mut history[k]) {
+            match visit(&law, &side_i, &side_j, &geom[k], &mut history[k]) {
                 Some((a, b)) => {
-                    add_assign(&mut fi, &a);
-                    add_assign(fj, &b);
+                    add_assign(&mut oi, &a);
+                    add_assign(oj, &b);
                 }
                 None => {
                     broken[k] = true;
@@ -231,7 +261,7 @@ fn pair_loop<M: Model, L: Fn(u16, u16) -> M::Law>(
                 }
             }
         }
-        add_assign(&mut force[i], &fi);
+        add_assign(&mut out[i], &oi);
     }
     newly_broken
 }

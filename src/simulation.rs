@@ -103,7 +103,7 @@ impl<M: Model> Simulation<M> {
         self.exchange.forward(p);
         t = self.timing.lap(Phase::Communication, t);
         if <M::State as Attributes>::LEN > 0 {
-            forces::state_pass(&self.model, p, &self.bonds);
+            forces::state_pass(&self.model, p, &mut self.bonds);
             self.exchange.reverse_state(p);
             forces::finish_state(&self.model, p);
             self.exchange.forward_state(p);
