@@ -68,14 +68,13 @@ fn mpirun_deck(np: usize, deck: &Path, extra: &[&str], dir: &Path) {
     );
 }
 
-#[test]
-fn mpi_ranks_agree_with_threads() {
-    let scene = deck::load(Path::new(DECK)).unwrap();
-    let threads_dir = out_dir("threads");
-    let reference = run(
+/// The deck run on 4 threads as 2×2×1 procCubes, the reference of the rank runs.
+fn threads_reference(deck_path: &Path, dir: &Path) -> pdq::run::Summary {
+    let scene = deck::load(deck_path).unwrap();
+    run(
         &scene,
         &RunOptions {
-            output: Some(threads_dir.clone()),
+            output: Some(dir.to_path_buf()),
             quiet: true,
             threads: Some(4),
             procs: Some(Procs::Given([2, 2, 1])),
@@ -83,7 +82,13 @@ fn mpi_ranks_agree_with_threads() {
             ..Default::default()
         },
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn mpi_ranks_agree_with_threads() {
+    let threads_dir = out_dir("threads");
+    let reference = threads_reference(Path::new(DECK), &threads_dir);
     assert!(reference.broken > 100);
     let (ref_pos, ref_broken) = read_final(&threads_dir);
     assert_eq!(ref_broken, reference.broken_pairs);
@@ -136,20 +141,8 @@ fn lps_micropolar_and_thermal_ranks_agree_with_threads() {
         std::fs::create_dir_all(&deck_dir).unwrap();
         let deck_path = deck_dir.join(format!("{model}_pull.toml"));
         std::fs::write(&deck_path, common::model_pull_deck(model)).unwrap();
-        let scene = deck::load(&deck_path).unwrap();
         let threads_dir = out_dir(&format!("{model}-threads"));
-        let reference = run(
-            &scene,
-            &RunOptions {
-                output: Some(threads_dir.clone()),
-                quiet: true,
-                threads: Some(4),
-                procs: Some(Procs::Given([2, 2, 1])),
-                walls: Some(Walls::Whole),
-                ..Default::default()
-            },
-        )
-        .unwrap();
+        let reference = threads_reference(&deck_path, &threads_dir);
         assert!(reference.broken > 50, "{model}: the deck must crack");
         let (ref_pos, ref_broken) = read_final(&threads_dir);
         for (np, extra) in [
