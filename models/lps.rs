@@ -151,19 +151,9 @@ impl Model for Lps {
                 }
             };
             let g = 3.0 * k * (1.0 - 2.0 * nu) / (2.0 * (1.0 + nu));
-            let s = match (m.critical_stretch, m.fracture_energy) {
-                (Some(s), None) => s,
-                (None, Some(g0)) => {
-                    (g0 / ((3.0 * g + 0.75f64.powi(4) * (k - 5.0 * g / 3.0)) * delta)).sqrt()
-                }
-                (None, None) => f64::INFINITY,
-                (Some(_), Some(_)) => {
-                    return Err(format!(
-                        "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
-                        m.name
-                    ))
-                }
-            };
+            let s = m.critical_stretch_or(|g0| {
+                (g0 / ((3.0 * g + 0.75f64.powi(4) * (k - 5.0 * g / 3.0)) * delta)).sqrt()
+            })?;
             if !(k.is_finite() && k > 0.0 && g > 0.0) {
                 return Err(format!(
                     "material '{}': the moduli must be > 0 (K = {k:e}, G = {g:e})",

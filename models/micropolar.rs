@@ -226,17 +226,9 @@ impl Model for Micropolar {
                     m.require(m.compressive_stretch, "compressive_stretch", Self::NAME)?,
                 )
             } else {
-                let s0 = match (m.critical_stretch, m.fracture_energy) {
-                    (Some(s), None) => s,
-                    (None, Some(g0)) => (5.0 * g0 * (1.0 - 2.0 * nu) / (3.0 * e * delta)).sqrt(),
-                    (None, None) => f64::INFINITY,
-                    (Some(_), Some(_)) => {
-                        return Err(format!(
-                            "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
-                            m.name
-                        ))
-                    }
-                };
+                let s0 = m.critical_stretch_or(|g0| {
+                    (5.0 * g0 * (1.0 - 2.0 * nu) / (3.0 * e * delta)).sqrt()
+                })?;
                 (s0, f64::NEG_INFINITY)
             };
             own.push(Own {

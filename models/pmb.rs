@@ -101,20 +101,8 @@ impl Model for Pmb {
             if !(c.is_finite() && c > 0.0) {
                 return Err(format!("material '{}': micromodulus must be > 0", m.name));
             }
-            let s0 = match (m.critical_stretch, m.fracture_energy) {
-                (Some(s0), None) => s0,
-                (None, Some(g0)) => {
-                    // s0 = sqrt(10 G0 / (π c δ⁵)), equal to sqrt(5G0/(9Kδ)) with c = 18K/(πδ⁴).
-                    (10.0 * g0 / (PI * c * delta.powi(5))).sqrt()
-                }
-                (None, None) => f64::INFINITY,
-                (Some(_), Some(_)) => {
-                    return Err(format!(
-                        "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
-                        m.name
-                    ))
-                }
-            };
+            // s0 = sqrt(10 G0 / (π c δ⁵)), equal to sqrt(5G0/(9Kδ)) with c = 18K/(πδ⁴).
+            let s0 = m.critical_stretch_or(|g0| (10.0 * g0 / (PI * c * delta.powi(5))).sqrt())?;
             if s0.is_nan() || s0 <= 0.0 {
                 return Err(format!(
                     "material '{}': critical stretch must be > 0",

@@ -105,17 +105,7 @@ impl Model for Thermal {
                 }
             };
             let c = 18.0 * k_bulk / (PI * delta.powi(4));
-            let s0 = match (m.critical_stretch, m.fracture_energy) {
-                (Some(s), None) => s,
-                (None, Some(g0)) => (10.0 * g0 / (PI * c * delta.powi(5))).sqrt(),
-                (None, None) => f64::INFINITY,
-                (Some(_), Some(_)) => {
-                    return Err(format!(
-                        "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
-                        m.name
-                    ))
-                }
-            };
+            let s0 = m.critical_stretch_or(|g0| (10.0 * g0 / (PI * c * delta.powi(5))).sqrt())?;
             own.push(Own {
                 c,
                 s0,

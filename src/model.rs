@@ -112,6 +112,20 @@ impl Material {
         Ok(())
     }
 
+    /// The critical stretch: `critical_stretch` as given, or from `fracture_energy` G0 by the
+    /// model's formula `from_energy(G0)`, or none (∞: the bonds never break); both is an error.
+    pub fn critical_stretch_or(&self, from_energy: impl FnOnce(f64) -> f64) -> Result<f64, String> {
+        match (self.critical_stretch, self.fracture_energy) {
+            (Some(s), None) => Ok(s),
+            (None, Some(g0)) => Ok(from_energy(g0)),
+            (None, None) => Ok(f64::INFINITY),
+            (Some(_), Some(_)) => Err(format!(
+                "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
+                self.name
+            )),
+        }
+    }
+
     /// A property the model cannot do without.
     pub fn require(&self, value: Option<f64>, key: &str, model: &str) -> Result<f64, String> {
         value.ok_or_else(|| format!("material '{}' needs '{key}' for model '{model}'", self.name))
