@@ -271,39 +271,71 @@ where
         let range = offsets[i] as usize..offsets[i + 1] as usize;
         let (partner, geom) = (&partner[range.clone()], &geom[range.clone()]);
         let (broken, history) = (&mut broken[range.clone()], &mut history[range]);
-        for k in 0..partner.len() {
-            if broken[k] {
+        // SAFETY: every partner index is below the particle count (BondList keeps the
+        // partner list private and its maximum; checked above), and all per-particle arrays
+        // have that length. Unchecked access lets the compiler drop the loads of fields the
+        // model never reads, which bounds checks would keep alive.
+        let side = |j: usize| unsafe {
+            Side::<M> {
+                x0: x0.get_unchecked(j),
+                volume: *volume.get_unchecked(j),
+                material: *material.get_unchecked(j),
+                alter: alter.get_unchecked(j),
+                fixed: fixed.get_unchecked(j),
+                state: state.get_unchecked(j),
+            }
+        };
+        let len = partner.len();
+        let mut k = 0;
+        while k < len {
+            // Two intact bonds at once if the model asks (`Model::PAIRED_BONDS`): two copies of
+            // the same arithmetic in one block, which the compiler pairs into vector
+            // instructions, one lane per bond. The sums are made in bond order either way.
+            let two = M::PAIRED_BONDS && k + 1 < len && !broken[k] && !broken[k + 1];
+            let n = if two { 2 } else { 1 };
+            if !two && broken[k] {
+                k += 1;
                 continue;
             }
-            let j = partner[k] as usize;
-            // SAFETY: every partner index is below the particle count (BondList keeps the
-            // partner list private and its maximum; checked above), and all per-particle
-            // arrays have that length. Unchecked access lets the compiler drop the loads of
-            // fields the model never reads, which bounds checks would keep alive.
-            let (side_j, oj) = unsafe {
-                (
-                    Side::<M> {
-                        x0: x0.get_unchecked(j),
-                        volume: *volume.get_unchecked(j),
-                        material: *material.get_unchecked(j),
-                        alter: alter.get_unchecked(j),
-                        fixed: fixed.get_unchecked(j),
-                        state: state.get_unchecked(j),
-                    },
-                    out.get_unchecked_mut(j),
-                )
+            let (j1, j2) = (
+                partner[k] as usize,
+                partner[(k + n - 1).min(len - 1)] as usize,
+            );
+            let (s1, s2) = (side(j1), side(j2));
+            let (h1, h2) = history[k..].split_at_mut(1);
+            let r1 = visit.visit(
+                &law_of(side_i.material, s1.material),
+                &side_i,
+                &s1,
+                &geom[k],
+                &mut h1[0],
+            );
+            let r2 = if two {
+                Some(visit.visit(
+                    &law_of(side_i.material, s2.material),
+                    &side_i,
+                    &s2,
+                    &geom[k + 1],
+                    &mut h2[0],
+                ))
+            } else {
+                None
             };
-            let law = law_of(side_i.material, side_j.material);
-            match visit.visit(&law, &side_i, &side_j, &geom[k], &mut history[k]) {
-                Some((a, b)) => {
-                    add_assign(&mut oi, &a);
-                    add_assign(oj, &b);
-                }
-                None => {
-                    broken[k] = true;
-                    newly_broken += 1;
+            for (m, r, j) in [(k, Some(r1), j1), (k + 1, r2, j2)] {
+                match r {
+                    Some(Some((a, b))) => {
+                        add_assign(&mut oi, &a);
+                        // SAFETY: as above.
+                        add_assign(unsafe { out.get_unchecked_mut(j) }, &b);
+                    }
+                    Some(None) => {
+                        broken[m] = true;
+                        newly_broken += 1;
+                    }
+                    None => {}
                 }
             }
+            k += n;
         }
         add_assign(&mut out[i], &oi);
     }
