@@ -37,16 +37,7 @@ pub fn state_pass<M: Model>(model: &M, p: &mut Particles<M>, bonds: &mut BondLis
         alter,
         state: ZeroState(&zero),
     };
-    let visit = StateOfBond(model);
-    match single_material(material) {
-        Some(m) => {
-            let law = model.law(m, m);
-            sweep(ends, bonds, state, |_, _| law, visit);
-        }
-        None => {
-            sweep(ends, bonds, state, |a, b| model.law(a, b), visit);
-        }
-    }
+    sweep_with_laws(model, ends, bonds, state, StateOfBond(model));
 }
 
 /// Turns summed states into final values (after the reverse sum brought ghosts' partials home).
@@ -86,14 +77,31 @@ pub fn pair_pass<M: Model>(
         alter,
         state: &state[..],
     };
-    let visit = PairOfBond(model);
-    // A scene of one material gets a loop with its law fixed: no material loads, no dispatch.
-    match single_material(material) {
+    sweep_with_laws(model, ends, bonds, force, PairOfBond(model))
+}
+
+/// [`sweep`] with the model's laws. A scene of one material gets a loop with its law fixed: no
+/// material loads, no dispatch.
+#[inline(always)]
+fn sweep_with_laws<M, T, St, V>(
+    model: &M,
+    ends: Ends<'_, M, St>,
+    bonds: &mut BondList<M::Bond>,
+    out: &mut [T],
+    visit: V,
+) -> usize
+where
+    M: Model,
+    T: Attributes,
+    St: States<M::State>,
+    V: BondVisit<M, T>,
+{
+    match single_material(ends.material) {
         Some(m) => {
             let law = model.law(m, m);
-            sweep(ends, bonds, force, |_, _| law, visit)
+            sweep(ends, bonds, out, |_, _| law, visit)
         }
-        None => sweep(ends, bonds, force, |a, b| model.law(a, b), visit),
+        None => sweep(ends, bonds, out, |a, b| model.law(a, b), visit),
     }
 }
 
@@ -297,12 +305,9 @@ where
                 k += 1;
                 continue;
             }
-            let (j1, j2) = (
-                partner[k] as usize,
-                partner[(k + n - 1).min(len - 1)] as usize,
-            );
-            let (s1, s2) = (side(j1), side(j2));
             let (h1, h2) = history[k..].split_at_mut(1);
+            let j1 = partner[k] as usize;
+            let s1 = side(j1);
             let r1 = visit.visit(
                 &law_of(side_i.material, s1.material),
                 &side_i,
@@ -310,36 +315,56 @@ where
                 &geom[k],
                 &mut h1[0],
             );
-            let r2 = if two {
-                Some(visit.visit(
-                    &law_of(side_i.material, s2.material),
-                    &side_i,
-                    &s2,
-                    &geom[k + 1],
-                    &mut h2[0],
-                ))
-            } else {
-                None
-            };
-            for (m, r, j) in [(k, Some(r1), j1), (k + 1, r2, j2)] {
-                match r {
-                    Some(Some((a, b))) => {
-                        add_assign(&mut oi, &a);
-                        // SAFETY: as above.
-                        add_assign(unsafe { out.get_unchecked_mut(j) }, &b);
-                    }
-                    Some(None) => {
-                        broken[m] = true;
-                        newly_broken += 1;
-                    }
-                    None => {}
-                }
+            let r2 = two.then(|| {
+                let j2 = partner[k + 1] as usize;
+                let s2 = side(j2);
+                let law = law_of(side_i.material, s2.material);
+                (
+                    j2,
+                    visit.visit(&law, &side_i, &s2, &geom[k + 1], &mut h2[0]),
+                )
+            });
+            // SAFETY (both): partners are in bounds, as above.
+            newly_broken += add_or_break(
+                r1,
+                &mut oi,
+                unsafe { out.get_unchecked_mut(j1) },
+                &mut broken[k],
+            );
+            if let Some((j2, r2)) = r2 {
+                newly_broken += add_or_break(
+                    r2,
+                    &mut oi,
+                    unsafe { out.get_unchecked_mut(j2) },
+                    &mut broken[k + 1],
+                );
             }
             k += n;
         }
         add_assign(&mut out[i], &oi);
     }
     newly_broken
+}
+
+/// Adds a bond's contributions to its two ends, or marks it broken; returns how many broke.
+#[inline(always)]
+fn add_or_break<T: Attributes>(
+    r: Option<(T, T)>,
+    oi: &mut T,
+    oj: &mut T,
+    broken: &mut bool,
+) -> usize {
+    match r {
+        Some((a, b)) => {
+            add_assign(oi, &a);
+            add_assign(oj, &b);
+            0
+        }
+        None => {
+            *broken = true;
+            1
+        }
+    }
 }
 
 /// The bonds' contributions to fixed data (see [`Model::bond_fixed`]), summed on both ends of
