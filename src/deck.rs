@@ -262,6 +262,10 @@ struct OutputSection {
     frames_every: Option<u64>,
     progress: Option<bool>,
     final_state: Option<bool>,
+    checkpoint_every: Option<u64>,
+    checkpoint_minutes: Option<f64>,
+    checkpoint_keep: Option<usize>,
+    restart: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -376,6 +380,14 @@ pub struct OutputSpec {
     pub progress: bool,
     /// Write `final_positions.csv` and `broken_bonds.csv` at the end.
     pub final_state: bool,
+    /// A checkpoint every N steps (0: none on a step count).
+    pub checkpoint_every: u64,
+    /// A checkpoint every so many minutes of wall time (0: none on the clock).
+    pub checkpoint_minutes: f64,
+    /// Checkpoints kept on disk (the newest ones).
+    pub checkpoint_keep: usize,
+    /// Resume from this checkpoint file, or the newest in this directory.
+    pub restart: Option<PathBuf>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -794,7 +806,17 @@ impl Converter {
             frames_every: out.frames_every.unwrap_or(0),
             progress: out.progress.unwrap_or(true),
             final_state: out.final_state.unwrap_or(false),
+            checkpoint_every: out.checkpoint_every.unwrap_or(0),
+            checkpoint_minutes: out.checkpoint_minutes.unwrap_or(0.0),
+            checkpoint_keep: out.checkpoint_keep.unwrap_or(3),
+            restart: out.restart.as_ref().map(PathBuf::from),
         };
+        if !(output.checkpoint_minutes.is_finite() && output.checkpoint_minutes >= 0.0) {
+            return self.err(out_line, "[output] checkpoint_minutes must be ≥ 0");
+        }
+        if output.checkpoint_keep == 0 {
+            return self.err(out_line, "[output] checkpoint_keep must be ≥ 1");
+        }
         let parallel = self.parallel(deck.parallel.as_ref())?;
         let mut periodic = [false; 3];
         for a in &lattice_periodic {

@@ -39,7 +39,13 @@ enum Cmd {
         /// Ghost messages: "whole" walls or "trimmed" to the cells each neighbour needs.
         #[arg(long, value_parser = parse_walls)]
         walls: Option<pdq::decomposition::Walls>,
+        /// Resume from a checkpoint file, or from the newest readable checkpoint in a
+        /// directory (an output directory or its checkpoints/).
+        #[arg(long)]
+        restart: Option<PathBuf>,
     },
+    /// Print what a frame or checkpoint file holds: step, time, particles, attributes, bonds.
+    Info { file: PathBuf },
     /// Check a deck: particles, bonds, memory, time step, and an estimated run time.
     Check { deck: PathBuf },
     /// List the models and the attributes each declares.
@@ -83,6 +89,7 @@ enum Cmd {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let mut interrupted = false;
     let result = match cli.command {
         Cmd::Run {
             deck: path,
@@ -92,9 +99,11 @@ fn main() -> ExitCode {
             threads,
             procs,
             walls,
+            restart,
         } => deck::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| {
+                pdq::signals::install()?;
                 run::run(
                     &scene,
                     &run::RunOptions {
@@ -107,10 +116,16 @@ fn main() -> ExitCode {
                         })),
                         procs,
                         walls,
+                        restart,
                     },
                 )
             })
-            .map(|_| ()),
+            .map(|s| {
+                if s.interrupted.is_some() {
+                    interrupted = true;
+                }
+            }),
+        Cmd::Info { file } => pdq::checkpoint::info(&file).map(|s| print!("{s}")),
         Cmd::Check { deck: path } => deck::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| run::check(&scene))
@@ -151,6 +166,7 @@ fn main() -> ExitCode {
         .map(|s| print!("{s}")),
     };
     match result {
+        Ok(()) if interrupted => ExitCode::from(pdq::signals::EXIT_INTERRUPTED),
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");

@@ -1,8 +1,8 @@
 //! What a run leaves behind: the CSV time history, particle frames for ParaView, progress.
 //!
-//! Frames are VTK XML unstructured grids (`.vtu`, one vertex cell per particle, raw binary
-//! appended data) tied into a time series by a `.pvd` collection, which ParaView opens
-//! directly. Every alterable attribute the model declares is written under its own name.
+//! Frames are HDF5 files (one per frame: the points, then one dataset per array, every
+//! attribute the model declares under its own name) tied into a time series by an XDMF file,
+//! `frames.xdmf`, which ParaView opens directly (choose the "Xdmf3 Reader" if it asks).
 
 use crate::attributes::Attributes;
 use crate::model::Model;
@@ -28,6 +28,29 @@ impl History {
         })
     }
 
+    /// Continues the history of a restarted run: rows up to `step` are kept (rows written
+    /// after the checkpoint the run resumes from are dropped), and new rows follow them.
+    pub fn resume(path: &Path, columns: &[String], step: u64) -> std::io::Result<History> {
+        let old = std::fs::read_to_string(path).unwrap_or_default();
+        let mut kept = format!("{}\n", columns.join(","));
+        for line in old.lines().skip(1) {
+            let s: Option<f64> = line.split(',').next().and_then(|v| v.parse().ok());
+            match s {
+                Some(s) if s <= step as f64 => {
+                    kept.push_str(line);
+                    kept.push('\n');
+                }
+                _ => break,
+            }
+        }
+        std::fs::write(path, kept)?;
+        let out = BufWriter::new(File::options().append(true).open(path)?);
+        Ok(History {
+            out,
+            path: path.to_path_buf(),
+        })
+    }
+
     pub fn row(&mut self, values: &[f64]) -> std::io::Result<()> {
         let mut first = true;
         for v in values {
@@ -47,25 +70,41 @@ impl History {
     }
 }
 
-/// A time series of `.vtu` frames and the `.pvd` file that lists them.
+/// A time series of HDF5 frames and the XDMF file that lists them.
 pub struct Frames {
     dir: PathBuf,
-    entries: Vec<(f64, String)>,
+    /// Step, time, particle count and arrays of each frame written, for the XDMF index.
+    entries: Vec<FrameEntry>,
 }
 
-/// One array of a frame.
-enum Array<'a> {
-    F64(&'a str, usize, Vec<f64>),
-    I32(&'a str, Vec<i32>),
+struct FrameEntry {
+    step: u64,
+    time: f64,
+    n: usize,
+    arrays: Vec<(String, usize, &'static str)>,
+}
+
+/// One array of a frame: name, components per particle, values (particle-major).
+enum Array {
+    F64(String, usize, Vec<f64>),
+    I32(String, Vec<i32>),
+}
+
+impl Array {
+    fn name(&self) -> &str {
+        match self {
+            Array::F64(n, _, _) | Array::I32(n, _) => n,
+        }
+    }
 }
 
 /// One array per field of `records`, named as the model declares it.
-fn push_fields<A: Attributes>(arrays: &mut Vec<Array<'static>>, records: &[A]) {
+fn push_fields<A: Attributes>(arrays: &mut Vec<Array>, records: &[A]) {
     let mut offset = 0;
     for f in A::FIELDS {
         let o = offset;
         arrays.push(Array::F64(
-            f.name,
+            f.name.to_string(),
             f.len,
             records
                 .iter()
@@ -74,6 +113,11 @@ fn push_fields<A: Attributes>(arrays: &mut Vec<Array<'static>>, records: &[A]) {
         ));
         offset += f.len;
     }
+}
+
+/// The file name of the frame at `step`, relative to the output directory.
+pub fn frame_name(step: u64) -> String {
+    format!("frames/frame_{step:08}.h5")
 }
 
 impl Frames {
@@ -85,117 +129,210 @@ impl Frames {
         })
     }
 
-    /// Writes the owned particles at `step`, then rewrites the `.pvd` index.
+    /// Continues the time series of a restarted run: the frames of steps up to `step` that
+    /// are on disk are listed again; later ones (written after the checkpoint the run resumes
+    /// from) are left out and overwritten when reached.
+    pub fn resume(dir: &Path, step: u64) -> Result<Frames, String> {
+        let mut frames = Frames::new(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let mut steps: Vec<u64> = std::fs::read_dir(dir.join("frames"))
+            .map_err(|e| format!("{}: {e}", dir.display()))?
+            .filter_map(|e| {
+                let name = e.ok()?.file_name().into_string().ok()?;
+                name.strip_prefix("frame_")?.strip_suffix(".h5")?.parse().ok()
+            })
+            .filter(|&s| s <= step)
+            .collect();
+        steps.sort_unstable();
+        for s in steps {
+            let path = dir.join(frame_name(s));
+            // A frame that cannot be read is left out of the series, not fatal.
+            if let Ok(entry) = read_entry(&path, s) {
+                frames.entries.push(entry);
+            }
+        }
+        Ok(frames)
+    }
+
+    /// Writes the owned particles at `step`, then rewrites the XDMF index.
     pub fn write<M: Model>(
         &mut self,
         step: u64,
         time: f64,
         p: &Particles<M>,
         damage: &[f64],
+        broken_bonds: usize,
     ) -> std::io::Result<PathBuf> {
         let n = p.n_owned;
-        let name = format!("frames/frame_{step:08}.vtu");
+        let name = frame_name(step);
         let path = self.dir.join(&name);
         let mut arrays = vec![
-            Array::I32("id", p.gid[..n].iter().map(|&g| g as i32).collect()),
+            Array::I32("id".into(), p.gid[..n].iter().map(|&g| g as i32).collect()),
             Array::I32(
-                "material",
+                "material".into(),
                 p.material[..n].iter().map(|&m| m as i32).collect(),
             ),
-            Array::F64("damage", 1, damage[..n].to_vec()),
+            Array::F64("damage".into(), 1, damage[..n].to_vec()),
             Array::F64(
-                "displacement",
+                "displacement".into(),
                 3,
                 (0..n).flat_map(|i| p.displacement(i)).collect(),
             ),
-            Array::F64("volume", 1, p.volume[..n].to_vec()),
+            Array::F64("volume".into(), 1, p.volume[..n].to_vec()),
         ];
         // Every declared per-particle attribute, by its declared name.
         push_fields(&mut arrays, &p.alter[..n]);
         push_fields(&mut arrays, &p.fixed[..n]);
         push_fields(&mut arrays, &p.state[..n]);
         push_fields(&mut arrays, &p.force[..n]);
+        let mut b = hdf5_pure::FileBuilder::new();
+        b.set_attr("step", hdf5_pure::AttrValue::U64(step));
+        b.set_attr("time", hdf5_pure::AttrValue::F64(time));
+        b.set_attr("model", hdf5_pure::AttrValue::String(M::NAME.into()));
+        b.set_attr("broken_bonds", hdf5_pure::AttrValue::U64(broken_bonds as u64));
         let points: Vec<f64> = (0..n).flat_map(|i| p.pos(i)).collect();
-        write_vtu(&path, &points, &arrays)?;
-        self.entries.push((time, name));
+        b.create_dataset("points")
+            .with_f64_data(&points)
+            .with_shape(&[n as u64, 3]);
+        // Polyvertex connectivity: ParaView does without it, other XDMF readers need it.
+        let cells: Vec<i32> = (0..n as i32).collect();
+        b.create_dataset("cells").with_i32_data(&cells);
+        let mut listed = Vec::new();
+        for a in &arrays {
+            match a {
+                Array::F64(name, comps, v) => {
+                    let d = b.create_dataset(name).with_f64_data(v);
+                    if *comps > 1 {
+                        d.with_shape(&[n as u64, *comps as u64]);
+                    }
+                    listed.push((name.clone(), *comps, "Float\" Precision=\"8"));
+                }
+                Array::I32(name, v) => {
+                    b.create_dataset(name).with_i32_data(v);
+                    listed.push((name.clone(), 1, "Int\" Precision=\"4"));
+                }
+            }
+        }
+        debug_assert!(arrays.iter().all(|a| !a.name().is_empty()));
+        write_atomically(&path, b)?;
+        self.entries.retain(|e| e.step < step);
+        self.entries.push(FrameEntry {
+            step,
+            time,
+            n,
+            arrays: listed,
+        });
         self.write_index()?;
         Ok(path)
     }
 
+    /// `frames.xdmf`: a temporal collection of point clouds, one HDF5 file per frame.
     fn write_index(&self) -> std::io::Result<()> {
-        let tmp = self.dir.join("frames.pvd.tmp");
-        let mut f = BufWriter::new(File::create(&tmp)?);
-        writeln!(f, "<?xml version=\"1.0\"?>")?;
-        writeln!(
-            f,
-            "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">"
-        )?;
-        writeln!(f, "  <Collection>")?;
-        for (t, name) in &self.entries {
-            writeln!(
-                f,
-                "    <DataSet timestep=\"{t:.10e}\" group=\"\" part=\"0\" file=\"{name}\"/>"
-            )?;
+        let mut x = String::new();
+        x.push_str("<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n");
+        x.push_str("<Grid Name=\"frames\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+        for e in &self.entries {
+            let file = frame_name(e.step);
+            let n = e.n;
+            let item = |name: &str, dims: &str, ty: &str| {
+                format!(
+                    "<DataItem Dimensions=\"{dims}\" NumberType=\"{ty}\" Format=\"HDF\">{file}:/{name}</DataItem>"
+                )
+            };
+            x.push_str(&format!(
+                "<Grid Name=\"step_{}\" GridType=\"Uniform\">\n<Time Value=\"{:.17e}\"/>\n",
+                e.step, e.time
+            ));
+            x.push_str(&format!(
+                "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{n}\" NodesPerElement=\"1\">{}</Topology>\n",
+                item("cells", &format!("{n}"), "Int\" Precision=\"4")
+            ));
+            x.push_str(&format!(
+                "<Geometry GeometryType=\"XYZ\">{}</Geometry>\n",
+                item("points", &format!("{n} 3"), "Float\" Precision=\"8")
+            ));
+            for (name, comps, ty) in &e.arrays {
+                let (kind, dims) = match comps {
+                    1 => ("Scalar", format!("{n}")),
+                    3 => ("Vector", format!("{n} 3")),
+                    9 => ("Tensor", format!("{n} 9")),
+                    c => ("Matrix", format!("{n} {c}")),
+                };
+                x.push_str(&format!(
+                    "<Attribute Name=\"{name}\" AttributeType=\"{kind}\" Center=\"Node\">{}</Attribute>\n",
+                    item(name, &dims, ty)
+                ));
+            }
+            x.push_str("</Grid>\n");
         }
-        writeln!(f, "  </Collection>\n</VTKFile>")?;
-        f.flush()?;
-        drop(f);
-        std::fs::rename(tmp, self.dir.join("frames.pvd"))
+        x.push_str("</Grid>\n</Domain>\n</Xdmf>\n");
+        let tmp = self.dir.join("frames.xdmf.tmp");
+        std::fs::write(&tmp, x)?;
+        std::fs::rename(tmp, self.dir.join("frames.xdmf"))
     }
 }
 
-/// A VTK XML unstructured grid of vertices with raw appended little-endian data.
-fn write_vtu(path: &Path, points: &[f64], arrays: &[Array]) -> std::io::Result<()> {
-    let n = points.len() / 3;
-    let mut f = BufWriter::new(File::create(path)?);
-    let mut blocks: Vec<Vec<u8>> = Vec::new();
-    let mut offset = 0usize;
-    let mut header = String::new();
-    let mut add = |bytes: Vec<u8>, blocks: &mut Vec<Vec<u8>>| -> usize {
-        let at = offset;
-        offset += 8 + bytes.len();
-        blocks.push(bytes);
-        at
+/// The XDMF entry of a frame on disk (a restarted run lists the frames it keeps).
+fn read_entry(path: &Path, step: u64) -> Result<FrameEntry, String> {
+    let f = hdf5_pure::File::open(path).map_err(|e| e.to_string())?;
+    let attrs = f.root().attrs().map_err(|e| e.to_string())?;
+    let time = match attrs.get("time") {
+        Some(hdf5_pure::AttrValue::F64(t)) => *t,
+        _ => return Err("no time".into()),
     };
-    header.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
-    header.push_str(&format!(
-        "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{n}\" NumberOfCells=\"{n}\">\n<PointData>\n"
-    ));
-    for a in arrays {
-        match a {
-            Array::F64(name, comps, v) => {
-                let at = add(bytemuck::cast_slice(v).to_vec(), &mut blocks);
-                header.push_str(&format!("<DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"{comps}\" format=\"appended\" offset=\"{at}\"/>\n"));
-            }
-            Array::I32(name, v) => {
-                let at = add(bytemuck::cast_slice(v).to_vec(), &mut blocks);
-                header.push_str(&format!("<DataArray type=\"Int32\" Name=\"{name}\" NumberOfComponents=\"1\" format=\"appended\" offset=\"{at}\"/>\n"));
-            }
+    let n = f
+        .dataset("points")
+        .and_then(|d| d.shape())
+        .map_err(|e| e.to_string())?
+        .first()
+        .copied()
+        .unwrap_or(0) as usize;
+    let mut arrays = Vec::new();
+    for name in f.root().datasets().map_err(|e| e.to_string())? {
+        if name == "points" || name == "cells" {
+            continue;
+        }
+        let d = f.dataset(&name).map_err(|e| e.to_string())?;
+        let shape = d.shape().map_err(|e| e.to_string())?;
+        let comps = shape.get(1).copied().unwrap_or(1) as usize;
+        let ty = if name == "id" || name == "material" {
+            "Int\" Precision=\"4"
+        } else {
+            "Float\" Precision=\"8"
+        };
+        arrays.push((name, comps, ty));
+    }
+    Ok(FrameEntry {
+        step,
+        time,
+        n,
+        arrays,
+    })
+}
+
+/// Writes an HDF5 file under a temporary name, syncs it and renames it into place, so that a
+/// reader (or a run killed while writing) never sees a partial file under the real name.
+pub fn write_atomically(path: &Path, b: hdf5_pure::FileBuilder) -> std::io::Result<()> {
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("file");
+    let tmp = path.with_file_name(format!(".{name}.tmp"));
+    let bytes = b
+        .finish()
+        .map_err(|e| std::io::Error::other(format!("HDF5: {e}")))?;
+    {
+        let mut f = File::create(&tmp)?;
+        f.write_all(&bytes)?;
+        f.sync_all()?;
+    }
+    std::fs::rename(&tmp, path)?;
+    if let Some(dir) = path.parent() {
+        // The rename itself reaches the disk with the directory.
+        if let Ok(d) = File::open(dir) {
+            let _ = d.sync_all();
         }
     }
-    header.push_str("</PointData>\n<Points>\n");
-    let at = add(bytemuck::cast_slice(points).to_vec(), &mut blocks);
-    header.push_str(&format!("<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"{at}\"/>\n</Points>\n<Cells>\n"));
-    let conn: Vec<i64> = (0..n as i64).collect();
-    let offs: Vec<i64> = (1..=n as i64).collect();
-    let types: Vec<u8> = vec![1; n];
-    let at = add(bytemuck::cast_slice(&conn).to_vec(), &mut blocks);
-    header.push_str(&format!(
-        "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"appended\" offset=\"{at}\"/>\n"
-    ));
-    let at = add(bytemuck::cast_slice(&offs).to_vec(), &mut blocks);
-    header.push_str(&format!(
-        "<DataArray type=\"Int64\" Name=\"offsets\" format=\"appended\" offset=\"{at}\"/>\n"
-    ));
-    let at = add(types, &mut blocks);
-    header.push_str(&format!("<DataArray type=\"UInt8\" Name=\"types\" format=\"appended\" offset=\"{at}\"/>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_"));
-    f.write_all(header.as_bytes())?;
-    for b in &blocks {
-        f.write_all(&(b.len() as u64).to_le_bytes())?;
-        f.write_all(b)?;
-    }
-    f.write_all(b"\n</AppendedData>\n</VTKFile>\n")?;
-    f.flush()
+    Ok(())
 }
 
 /// A progress bar with ETA on a terminal; a plain line every 10% otherwise.

@@ -241,7 +241,7 @@ impl<M: Model> Cube<M> {
             self.sim.particles.fixed = fixed;
         }
         for c in &self.sim.constraints {
-            c.set_velocity(&mut self.sim.particles, 0.0, self.sim.dt);
+            c.set_velocity(&mut self.sim.particles, self.sim.time, self.sim.dt);
         }
         self.sim.compute_forces();
     }

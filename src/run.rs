@@ -1,6 +1,7 @@
 //! `pdq run` and `pdq check`: drive a simulation built from a deck and report on it.
 
 use crate::attributes::Attributes;
+use crate::checkpoint::{self, Checkpoint};
 use crate::comm::{f64s, Reduce, Team, Transport};
 use crate::deck::Scene;
 use crate::decomposition::{Layout, Procs, Walls};
@@ -36,6 +37,12 @@ pub struct Summary {
     /// Final damage by global id.
     pub damage: Vec<f64>,
     pub broken_pairs: Vec<(u32, u32)>,
+    /// The run stopped early on SIGTERM or SIGINT after writing this checkpoint.
+    pub interrupted: Option<PathBuf>,
+    /// Checkpoints written: path, size in bytes, seconds to gather and write.
+    pub checkpoints: Vec<(PathBuf, u64, f64)>,
+    /// The step the run started from (a restart's checkpoint step, else 0).
+    pub first_step: u64,
 }
 
 /// Options the command line may set over the deck.
@@ -48,6 +55,8 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     pub procs: Option<Procs>,
     pub walls: Option<Walls>,
+    /// Resume from this checkpoint, or from the newest readable one in this directory.
+    pub restart: Option<PathBuf>,
 }
 
 /// Runs a deck to the end.
@@ -227,6 +236,33 @@ struct Plan {
     shuffle_every: u64,
     n_probes: usize,
     layout: String,
+    /// The step the loop starts from: 0, or the step of the checkpoint it resumes.
+    first_step: u64,
+    checkpoints: CheckpointPlan,
+}
+
+/// When to write checkpoints, and what identifies them.
+struct CheckpointPlan {
+    dir: PathBuf,
+    every: u64,
+    minutes: f64,
+    keep: usize,
+    scene_hash: u64,
+    deck: String,
+}
+
+impl CheckpointPlan {
+    fn enabled(&self) -> bool {
+        self.every > 0 || self.minutes > 0.0
+    }
+}
+
+/// Whether to stop on a signal and whether the wall clock calls for a checkpoint, agreed by
+/// all workers (each sees its own signal flag and clock; all must act at the same step).
+fn agree_on_stop<M: Model>(cube: &mut Cube<M>, stop: bool, clock_due: bool) -> (bool, bool) {
+    let mut v = [stop as u8 as f64, clock_due as u8 as f64];
+    Team::new(cube.sim.exchange.transport()).reduce(&mut v, Reduce::Max);
+    (v[0] > 0.0, v[1] > 0.0)
 }
 
 /// The step loop of one worker; the root (rank 0) writes the output and returns the summary.
@@ -234,10 +270,17 @@ fn drive<M: Model>(
     mut cube: Cube<M>,
     plan: &Plan,
     mut store: Option<FrameStore<M>>,
+    resume: Option<&Checkpoint>,
 ) -> Result<Option<Summary>, String> {
     let root = cube.sim.exchange.transport().rank() == 0;
     let t = Instant::now();
+    if let Some(c) = resume {
+        c.restore_bonds(&mut cube);
+    }
     cube.start();
+    if let Some(c) = resume {
+        c.restore_forces(&mut cube);
+    }
     cube.sim.timing.lap(Phase::Setup, t);
     let dir = &plan.dir;
     let io = |e: std::io::Error| format!("writing output in {}: {e}", dir.display());
@@ -245,24 +288,39 @@ fn drive<M: Model>(
     let mut error: Option<String> = None;
     let mut history = None;
     let mut frames = None;
+    let first = plan.first_step;
     if root {
-        match History::create(&dir.join("history.csv"), &plan.columns) {
+        let h = if first > 0 {
+            History::resume(&dir.join("history.csv"), &plan.columns, first)
+        } else {
+            History::create(&dir.join("history.csv"), &plan.columns)
+        };
+        match h {
             Ok(h) => history = Some(h),
             Err(e) => error = Some(io(e)),
         }
         if plan.frames_every > 0 && error.is_none() {
-            match Frames::new(dir) {
+            let f = if first > 0 {
+                Frames::resume(dir, first)
+            } else {
+                Frames::new(dir).map_err(io)
+            };
+            match f {
                 Ok(f) => frames = Some(f),
-                Err(e) => error = Some(io(e)),
+                Err(e) => error = Some(e),
             }
         }
     }
+    let ck = &plan.checkpoints;
+    let mut checkpoints: Vec<(PathBuf, u64, f64)> = Vec::new();
+    let mut last_checkpoint = Instant::now();
+    let mut interrupted = None;
     let mut progress = Progress::new(plan.steps, root && plan.progress && !plan.quiet);
     let wall = Instant::now();
     let mut broken = 0usize;
     let mut shuffles = 0u64;
-    for step in 0..=plan.steps {
-        if step > 0 {
+    for step in first..=plan.steps {
+        if step > first {
             cube.sim.advance();
             if plan.shuffle_every > 0 && step % plan.shuffle_every == 0 {
                 let t = Instant::now();
@@ -274,8 +332,11 @@ fn drive<M: Model>(
             }
         }
         let last = step == plan.steps;
-        let want_row = step % plan.every == 0 || last;
-        let want_frame = plan.frames_every > 0 && (step % plan.frames_every == 0 || last);
+        // A restarted run has the row and frame of its first step from before.
+        let again = first > 0 && step == first;
+        let want_row = (step % plan.every == 0 || last) && !again;
+        let want_frame =
+            plan.frames_every > 0 && (step % plan.frames_every == 0 || last) && !again;
         if want_row || want_frame {
             let t = Instant::now();
             if any_failed(&mut cube, error.is_some()) {
@@ -294,7 +355,8 @@ fn drive<M: Model>(
             if want_frame {
                 gather_frame(&mut cube, &damage, &mut store);
                 if let (Some(f), Some(s)) = (frames.as_mut(), store.as_ref()) {
-                    if let Err(e) = f.write(step, cube.sim.time, &s.particles, &s.damage) {
+                    if let Err(e) = f.write(step, cube.sim.time, &s.particles, &s.damage, broken)
+                    {
                         error = Some(io(e));
                     }
                 }
@@ -302,7 +364,50 @@ fn drive<M: Model>(
             cube.sim.timing.lap(Phase::Output, t);
         }
         progress.update(step, broken);
+        if step > first {
+            // Every step: all workers must see a signal at the same step.
+            let clock_due = ck.minutes > 0.0
+                && last_checkpoint.elapsed().as_secs_f64() >= 60.0 * ck.minutes;
+            let (stop, clock_due) =
+                agree_on_stop(&mut cube, crate::signals::requested(), clock_due);
+            let due = stop
+                || clock_due
+                || (ck.every > 0 && step % ck.every == 0)
+                || (ck.enabled() && last);
+            if due {
+                let t = Instant::now();
+                let c = Checkpoint::gather(&mut cube, ck.scene_hash, &ck.deck);
+                if let Some(c) = c {
+                    match c.write(&ck.dir, ck.keep) {
+                        Ok((path, size)) => {
+                            checkpoints.push((path, size, t.elapsed().as_secs_f64()))
+                        }
+                        Err(e) => {
+                            error = Some(format!(
+                                "writing checkpoint in {}: {e}",
+                                ck.dir.display()
+                            ))
+                        }
+                    }
+                }
+                last_checkpoint = Instant::now();
+                cube.sim.timing.lap(Phase::Output, t);
+            }
+            if stop {
+                if any_failed(&mut cube, error.is_some()) {
+                    return Err(error.unwrap_or_else(|| "another worker failed".into()));
+                }
+                interrupted = Some(
+                    checkpoints
+                        .last()
+                        .map(|c| c.0.clone())
+                        .unwrap_or_else(|| ck.dir.clone()),
+                );
+                break;
+            }
+        }
     }
+    let steps_done = cube.sim.step;
     if any_failed(&mut cube, error.is_some()) {
         return Err(error.unwrap_or_else(|| "another worker failed".into()));
     }
@@ -371,7 +476,10 @@ fn drive<M: Model>(
         .iter()
         .map(|b| f64s(b))
         .collect();
-    let mut timing = cube.sim.timing.table(n_global as f64 * plan.steps as f64);
+    let mut timing = cube
+        .sim
+        .timing
+        .table(n_global as f64 * (steps_done - first) as f64);
     let _ = writeln!(
         timing,
         "bonds: {} ({} broken); {}{}",
@@ -385,7 +493,7 @@ fn drive<M: Model>(
         }
     );
     if balance.len() > 1 {
-        timing.push_str(&balance_table(&balance, plan.steps));
+        timing.push_str(&balance_table(&balance, steps_done - first));
     }
     if let Some(h) = history.as_mut() {
         h.flush().map_err(io)?;
@@ -394,10 +502,19 @@ fn drive<M: Model>(
     if plan.final_state {
         write_final_state(dir, &position, &damage_by_id, &broken_pairs).map_err(io)?;
     }
+    if let Some((_, size, secs)) = checkpoints.last() {
+        let _ = writeln!(
+            timing,
+            "checkpoints: {} written, the last {:.1} MB in {:.3} s",
+            checkpoints.len(),
+            *size as f64 / 1e6,
+            secs
+        );
+    }
     Ok(Some(Summary {
         particles: n_global,
         bonds: totals[0] as usize,
-        steps: plan.steps,
+        steps: steps_done,
         dt: cube.sim.dt,
         broken: totals[1] as usize,
         kinetic_energy: totals[2],
@@ -410,6 +527,9 @@ fn drive<M: Model>(
         positions: position,
         damage: damage_by_id,
         broken_pairs,
+        interrupted,
+        checkpoints,
+        first_step: first,
     }))
 }
 
@@ -509,6 +629,21 @@ fn run_setup<M: Model>(
         .output
         .clone()
         .unwrap_or_else(|| scene.output.directory.clone());
+    let scene_hash = checkpoint::scene_hash(&setup);
+    let resume = match opts.restart.as_ref().or(scene.output.restart.as_ref()) {
+        Some(from) => Some(resume_from(&mut setup, from, scene_hash)?),
+        None => None,
+    };
+    let resume = resume.as_ref();
+    if let (Some(c), false) = (resume, opts.quiet) {
+        eprintln!(
+            "restart    from step {} (t = {:.6e}) of {}: {} broken bonds",
+            c.step,
+            c.time,
+            c.deck,
+            c.broken.len()
+        );
+    }
     let plan = |layout: &Layout| Plan {
         columns: columns(&setup),
         dir: dir.clone(),
@@ -521,6 +656,15 @@ fn run_setup<M: Model>(
         shuffle_every: scene.parallel.shuffle_every,
         n_probes: setup.probes.len(),
         layout: layout.describe(),
+        first_step: resume.map_or(0, |c| c.step),
+        checkpoints: CheckpointPlan {
+            dir: dir.join("checkpoints"),
+            every: scene.output.checkpoint_every,
+            minutes: scene.output.checkpoint_minutes,
+            keep: scene.output.checkpoint_keep,
+            scene_hash,
+            deck: scene.file.clone(),
+        },
     };
 
     #[cfg(feature = "mpi")]
@@ -539,7 +683,7 @@ fn run_setup<M: Model>(
         let cube = parallel::build_cube(&setup, &layout, &plans, rank, Box::new(mpi));
         let p = plan(&layout);
         let store = (rank == 0).then(|| frame_store(setup));
-        let summary = drive(cube, &p, store)?;
+        let summary = drive(cube, &p, store, resume)?;
         return match summary {
             Some(s) => {
                 report(&s, opts, scene.output.frames_every > 0);
@@ -562,7 +706,7 @@ fn run_setup<M: Model>(
         } else {
             None
         };
-        drive(cube, &p, s)
+        drive(cube, &p, s, resume)
     });
     let mut summary = None;
     for r in results {
@@ -573,6 +717,38 @@ fn run_setup<M: Model>(
     let summary = summary.ok_or("the root procCube returned no summary")?;
     report(&summary, opts, scene.output.frames_every > 0);
     Ok(summary)
+}
+
+/// Reads the checkpoint to resume from, checks that it belongs to this deck, and puts its
+/// particles into the freshly built scene.
+fn resume_from<M: Model>(
+    setup: &mut Setup<M>,
+    from: &std::path::Path,
+    scene_hash: u64,
+) -> Result<Checkpoint, String> {
+    let (path, c) = checkpoint::resolve(from)?;
+    c.check_matches::<M>(&path, scene_hash, setup.sim.particles.len())?;
+    let sim = &setup.sim;
+    if c.dt != sim.dt || checkpoint::integrator(&c.integrator) != Some(sim.integrator) {
+        return Err(format!(
+            "checkpoint {}: it was written with time step {:e} ({}), the deck now gives {:e} ({}); a restart continues with the same integration",
+            path.display(),
+            c.dt,
+            c.integrator,
+            sim.dt,
+            sim.integrator.name()
+        ));
+    }
+    if c.step >= setup.steps {
+        return Err(format!(
+            "checkpoint {} is at step {}, the run ends at step {}: nothing to do (give more steps with --steps)",
+            path.display(),
+            c.step,
+            setup.steps
+        ));
+    }
+    c.restore_particles(setup);
+    Ok(c)
 }
 
 fn frame_store<M: Model>(setup: Setup<M>) -> FrameStore<M> {
@@ -614,6 +790,16 @@ fn prepare<M: Model>(
 }
 
 fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
+    if let Some(c) = &summary.interrupted {
+        // Said even with --quiet: the run did not finish.
+        eprintln!(
+            "stopped    by a signal at step {}; checkpoint {}\nresume     with: pdq run DECK --restart {} (exit code {})",
+            summary.steps,
+            c.display(),
+            c.display(),
+            crate::signals::EXIT_INTERRUPTED
+        );
+    }
     if opts.quiet {
         return;
     }
@@ -626,7 +812,7 @@ fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
         "results    {}: history.csv, timing.txt{}",
         summary.output.display(),
         if frames {
-            ", frames.pvd (open in ParaView; colour by damage)"
+            ", frames.xdmf (open in ParaView; colour by damage)"
         } else {
             ""
         }

@@ -1,4 +1,5 @@
-"""Reads a run's ParaView output with meshio (an independent VTK reader) and checks it.
+"""Reads a run's ParaView output (frames.xdmf and its HDF5 frames) with meshio's XDMF time
+series reader and h5py (independent readers) and checks it.
 
 Usage: python3 tests/check_frames.py OUTPUT_DIR [--same-as OTHER_DIR]
 
@@ -7,52 +8,66 @@ same particles with the same damage and, to round-off, the same positions and fo
 """
 import csv
 import sys
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import h5py
 import meshio
 import numpy as np
 
+
+def read_series(out):
+    """Times, and per frame the point data, of an output directory's frames.xdmf."""
+    frames = []
+    with meshio.xdmf.TimeSeriesReader(out / "frames.xdmf") as reader:
+        points, cells = reader.read_points_cells()
+        assert cells and cells[0].type == "vertex", cells
+        assert len(cells[0].data) == len(points), "one vertex cell per particle"
+        for k in range(reader.num_steps):
+            t, point_data, _ = reader.read_data(k)
+            frames.append((t, point_data))
+    return frames
+
+
 out = Path(sys.argv[1])
-series = ET.parse(out / "frames.pvd").getroot().find("Collection")
-entries = series.findall("DataSet")
-assert len(entries) >= 2, "a time series needs several frames"
-times = [float(e.get("timestep")) for e in entries]
+frames = read_series(out)
+assert len(frames) >= 2, "a time series needs several frames"
+times = [t for t, _ in frames]
 assert times == sorted(times), "frame times must increase"
-for e in entries:
-    mesh = meshio.read(out / e.get("file"))
-    n = len(mesh.points)
+h5_files = sorted((out / "frames").glob("frame_*.h5"))
+assert len(h5_files) == len(frames), (len(h5_files), len(frames))
+for (t, data), path in zip(frames, h5_files):
+    n = len(data["id"])
     for name, comps in [("id", 1), ("material", 1), ("damage", 1), ("displacement", 3),
                         ("pos", 3), ("vel", 3), ("force", 3)]:
-        a = mesh.point_data[name]
+        a = data[name]
         assert a.shape[0] == n and (a.ndim == 1 or a.shape[1] == comps), (name, a.shape)
-    assert np.allclose(mesh.points, mesh.point_data["pos"]), "points are current positions"
-    d = mesh.point_data["damage"]
+    with h5py.File(path, "r") as f:
+        assert abs(f.attrs["time"] - t) <= 1e-12 * max(abs(t), 1e-300), "time attribute"
+        assert np.array_equal(f["points"][()], data["pos"]), "points are current positions"
+    d = data["damage"]
     assert ((d >= 0) & (d <= 1)).all(), "damage lies in [0, 1]"
-    assert sorted(mesh.point_data["id"]) == list(range(n)), "ids are 0..n-1"
-first = meshio.read(out / entries[0].get("file"))
-last = meshio.read(out / entries[-1].get("file"))
+    assert sorted(data["id"]) == list(range(n)), "ids are 0..n-1"
+first, last = frames[0][1], frames[-1][1]
 # Frames carry each step's forces, not the ones of the first step.
-assert not np.allclose(first.point_data["force"], last.point_data["force"]), \
+assert not np.allclose(first["force"], last["force"]), \
     "the force array does not change between the first and the last frame"
-assert np.abs(last.point_data["displacement"]).max() > 0, "nothing moved"
+assert np.abs(last["displacement"]).max() > 0, "nothing moved"
 rows = list(csv.DictReader(open(out / "history.csv")))
-assert abs(float(rows[-1]["max_damage"]) - last.point_data["damage"].max()) < 1e-9
+assert abs(float(rows[-1]["max_damage"]) - last["damage"].max()) < 1e-9
 if len(sys.argv) > 3 and sys.argv[2] == "--same-as":
     other_dir = Path(sys.argv[3])
-    o_series = ET.parse(other_dir / "frames.pvd").getroot().find("Collection").findall("DataSet")
-    other = meshio.read(other_dir / o_series[-1].get("file"))
-    a = np.argsort(last.point_data["id"])
-    b = np.argsort(other.point_data["id"])
-    assert (last.point_data["id"][a] == other.point_data["id"][b]).all(), "different particles"
-    assert (last.point_data["damage"][a] == other.point_data["damage"][b]).all(), "damage differs"
-    scale = np.abs(last.point_data["pos"]).max()
-    dp = np.abs(last.point_data["pos"][a] - other.point_data["pos"][b]).max() / scale
+    other = read_series(other_dir)[-1][1]
+    a = np.argsort(last["id"])
+    b = np.argsort(other["id"])
+    assert (last["id"][a] == other["id"][b]).all(), "different particles"
+    assert (last["damage"][a] == other["damage"][b]).all(), "damage differs"
+    scale = np.abs(last["pos"]).max()
+    dp = np.abs(last["pos"][a] - other["pos"][b]).max() / scale
     assert dp <= 1e-12, f"positions differ by {dp:e}"
-    fs = np.abs(last.point_data["force"]).max()
-    df = np.abs(last.point_data["force"][a] - other.point_data["force"][b]).max() / fs
+    fs = np.abs(last["force"]).max()
+    df = np.abs(last["force"][a] - other["force"][b]).max() / fs
     assert df <= 1e-9, f"forces differ by {df:e}"
     print(f"same as {other_dir}: positions within {dp:.1e}, forces within {df:.1e}")
-print(f"frames ok: {len(entries)} frames of {len(last.points)} particles, "
-      f"max damage {last.point_data['damage'].max():.3f}, "
+print(f"frames ok: {len(frames)} frames of {len(last['id'])} particles, "
+      f"max damage {last['damage'].max():.3f}, "
       f"{int(float(rows[-1]['broken_bonds']))} broken bonds")

@@ -7,43 +7,24 @@ use pdq::run::{run, RunOptions};
 
 mod common;
 
-/// Array names and one value per particle of the last frame's `name` array (first component).
+/// Array names and one value per particle of the last frame's `name` array (first component),
+/// read back from the HDF5 file.
 fn last_frame(dir: &std::path::Path, name: &str) -> (Vec<String>, Vec<f64>) {
     let mut frames: Vec<_> = std::fs::read_dir(dir.join("frames"))
         .unwrap()
         .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "h5"))
         .collect();
     frames.sort();
-    let bytes = std::fs::read(frames.last().unwrap()).unwrap();
-    let start = bytes
-        .windows(13)
-        .position(|w| w == b"<AppendedData")
-        .unwrap();
-    let header = String::from_utf8_lossy(&bytes[..start]);
-    let mut names = Vec::new();
-    let mut wanted = None;
-    for tag in header.split("<DataArray").skip(1) {
-        let attr = |key: &str| {
-            let at = tag.find(&format!(" {key}=\""))? + key.len() + 3;
-            Some(tag[at..at + tag[at..].find('"')?].to_string())
-        };
-        // The point coordinates' array has no name.
-        let Some(this) = attr("Name") else { continue };
-        if this == name {
-            let comps: usize = attr("NumberOfComponents").unwrap().parse().unwrap();
-            wanted = Some((attr("offset").unwrap().parse::<usize>().unwrap(), comps));
-        }
-        names.push(this);
-    }
-    // Appended raw data: after the '_' marker, each array is a u64 byte count and the values.
-    let data = &bytes[start..];
-    let data = &data[data.iter().position(|&b| b == b'_').unwrap() + 1..];
-    let (offset, comps) = wanted.unwrap_or_else(|| panic!("no array '{name}' in {names:?}"));
-    let len = u64::from_le_bytes(data[offset..offset + 8].try_into().unwrap()) as usize;
-    let values: Vec<f64> = data[offset + 8..offset + 8 + len]
-        .chunks(8)
-        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
-        .collect();
+    let f = hdf5_pure::File::open(frames.last().unwrap()).unwrap();
+    let names = f.root().datasets().unwrap();
+    assert!(
+        names.iter().any(|n| n == name),
+        "no array '{name}' in {names:?}"
+    );
+    let d = f.dataset(name).unwrap();
+    let comps = d.shape().unwrap().get(1).copied().unwrap_or(1) as usize;
+    let values = d.read_f64().unwrap();
     (names, values.chunks(comps).map(|c| c[0]).collect())
 }
 

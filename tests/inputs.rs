@@ -62,6 +62,6 @@ fn quick_example_runs_and_cracks() {
         );
     }
     assert_eq!(history.lines().count(), 1 + 1 + 2000 / 20);
-    assert!(dir.join("frames.pvd").exists() && dir.join("timing.txt").exists());
+    assert!(dir.join("frames.xdmf").exists() && dir.join("timing.txt").exists());
     std::fs::remove_dir_all(dir).unwrap();
 }
