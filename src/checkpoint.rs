@@ -88,15 +88,18 @@ impl Fnv {
     }
 }
 
-/// The scene a checkpoint belongs to: model, schema, and the reference state of every
-/// particle by global id, as the deck builds it (before a restart changes anything).
-pub fn scene_hash<M: Model>(setup: &Setup<M>) -> u64 {
+/// The scene a checkpoint belongs to: model, schema, materials, horizon, and the reference
+/// state of every particle by global id, as the deck builds it (before a restart changes
+/// anything). Steps, output and layout may change between a run and its restart.
+pub fn scene_hash<M: Model>(setup: &Setup<M>, scene: &crate::deck::Scene) -> u64 {
     let p = &setup.sim.particles;
     let mut order: Vec<usize> = (0..p.len()).collect();
     order.sort_unstable_by_key(|&i| p.gid[i]);
     let mut h = Fnv::new();
     h.bytes(M::NAME.as_bytes());
     h.bytes(schema::<M>().as_bytes());
+    h.bytes(format!("{:?}{:?}", scene.materials, scene.model_options).as_bytes());
+    h.f64s(&[setup.horizon, setup.spacing]);
     h.bytes(&(p.len() as u64).to_le_bytes());
     for i in order {
         h.f64s(&p.x0[i]);
@@ -131,11 +134,7 @@ pub fn file_name(step: u64) -> String {
 impl Checkpoint {
     /// Gathers the state of every procCube on the root, which gets the checkpoint; every
     /// worker must call it.
-    pub fn gather<M: Model>(
-        cube: &mut Cube<M>,
-        scene_hash: u64,
-        deck: &str,
-    ) -> Option<Checkpoint> {
+    pub fn gather<M: Model>(cube: &mut Cube<M>, scene_hash: u64, deck: &str) -> Option<Checkpoint> {
         let la = <M::Alter as Attributes>::LEN;
         let lb = <M::Bond as Attributes>::LEN;
         let lf = <M::Force as Attributes>::LEN;
@@ -239,7 +238,9 @@ impl Checkpoint {
         b.set_attr("checksum", AttrValue::U64(checksum(self)));
         let n = self.x0.len() as u64;
         let x0: Vec<f64> = self.x0.iter().flatten().copied().collect();
-        b.create_dataset("x0").with_f64_data(&x0).with_shape(&[n, 3]);
+        b.create_dataset("x0")
+            .with_f64_data(&x0)
+            .with_shape(&[n, 3]);
         // One dataset per alterable field and per force field, by its declared name.
         let parts: Vec<&str> = self.schema.split('|').collect();
         for (prefix, fields, values) in [
@@ -260,7 +261,8 @@ impl Checkpoint {
                 at += l;
             }
         }
-        let pairs = |p: &[(u32, u32)]| -> Vec<u32> { p.iter().flat_map(|&(a, b)| [a, b]).collect() };
+        let pairs =
+            |p: &[(u32, u32)]| -> Vec<u32> { p.iter().flat_map(|&(a, b)| [a, b]).collect() };
         b.create_dataset("broken_bonds")
             .with_u32_data(&pairs(&self.broken))
             .with_shape(&[self.broken.len() as u64, 2]);
@@ -268,13 +270,16 @@ impl Checkpoint {
         b.create_dataset("history_bonds")
             .with_u32_data(&pairs(&self.history_pairs))
             .with_shape(&[m, 2]);
-        let lb = if m > 0 {
-            self.history.len() as u64 / m
-        } else {
-            0
-        };
-        b.create_dataset("history").with_f64_data(&self.history).with_shape(&[m, lb]);
-        crate::output::write_atomically(&path, b)?;
+        let lb = (self.history.len() as u64).checked_div(m).unwrap_or(0);
+        b.create_dataset("history")
+            .with_f64_data(&self.history)
+            .with_shape(&[m, lb]);
+        // A testing aid (tests/checkpoint.rs kills a run while it writes); not for users.
+        let pause = std::env::var("PDQ_CHECKPOINT_PAUSE_MS")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .map(std::time::Duration::from_millis);
+        crate::output::write_atomically(&path, b, pause)?;
         let size = std::fs::metadata(&path)?.len();
         let mut old = list(dir);
         old.sort_unstable();
@@ -292,15 +297,22 @@ impl Checkpoint {
         let what = |e: String| format!("checkpoint {}: {e}", path.display());
         // The HDF5 reader is asked to parse whatever the file holds; a damaged file must give
         // an error, so a panic inside it becomes one too.
-        let read = std::panic::catch_unwind(|| read_file(path));
+        let read = quietly(|| read_file(path));
         match read {
             Ok(r) => r.map_err(what),
-            Err(_) => Err(what("the file is damaged (the HDF5 reader failed on it)".into())),
+            Err(_) => Err(what(
+                "the file is damaged (the HDF5 reader failed on it)".into(),
+            )),
         }
     }
 
     /// Refuses a checkpoint written by another deck or model.
-    pub fn check_matches<M: Model>(&self, path: &Path, scene_hash: u64, n: usize) -> Result<(), String> {
+    pub fn check_matches<M: Model>(
+        &self,
+        path: &Path,
+        scene_hash: u64,
+        n: usize,
+    ) -> Result<(), String> {
         let refuse = |e: String| {
             Err(format!(
                 "checkpoint {} does not belong to this deck: {e}",
@@ -308,7 +320,11 @@ impl Checkpoint {
             ))
         };
         if self.model != M::NAME {
-            return refuse(format!("it is of model '{}', the deck uses '{}'", self.model, M::NAME));
+            return refuse(format!(
+                "it is of model '{}', the deck uses '{}'",
+                self.model,
+                M::NAME
+            ));
         }
         if self.schema != schema::<M>() {
             return refuse(format!(
@@ -325,7 +341,7 @@ impl Checkpoint {
         }
         if self.scene_hash != scene_hash {
             return refuse(format!(
-                "the deck's geometry or materials differ (scene hash {:016x}, the deck gives {scene_hash:016x}; written from {})",
+                "the deck's geometry, materials or model options differ (scene hash {:016x}, the deck gives {scene_hash:016x}; written from {})",
                 self.scene_hash, self.deck
             ));
         }
@@ -408,6 +424,16 @@ impl Checkpoint {
     }
 }
 
+/// Runs `f`, turning a panic into `Err` without the panic message on stderr: the file readers
+/// must answer a damaged file with an error of their own.
+fn quietly<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    std::panic::set_hook(hook);
+    r
+}
+
 fn parse_fields(s: &str) -> Vec<(String, usize)> {
     s.split(',')
         .filter(|f| !f.is_empty())
@@ -427,7 +453,11 @@ fn list(dir: &Path) -> Vec<(u64, PathBuf)> {
         .filter_map(|e| {
             let e = e.ok()?;
             let name = e.file_name().into_string().ok()?;
-            let step = name.strip_prefix("checkpoint_")?.strip_suffix(".h5")?.parse().ok()?;
+            let step = name
+                .strip_prefix("checkpoint_")?
+                .strip_suffix(".h5")?
+                .parse()
+                .ok()?;
             Some((step, e.path()))
         })
         .collect()
@@ -457,7 +487,10 @@ pub fn resolve(path: &Path) -> Result<(PathBuf, Checkpoint), String> {
         }
     }
     if problems.is_empty() {
-        Err(format!("no checkpoint (checkpoint_*.h5) in {}", dir.display()))
+        Err(format!(
+            "no checkpoint (checkpoint_*.h5) in {}",
+            dir.display()
+        ))
     } else {
         Err(format!(
             "no readable checkpoint in {}: {}",
@@ -499,11 +532,15 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
         .attrs()
         .map_err(|e| format!("cannot read its attributes ({e})"))?;
     if attr_string(&a, "format").ok().as_deref() != Some(FORMAT) {
-        return Err("not a PDQ checkpoint (no format = \"pdq-checkpoint\" attribute; a frame file?)".into());
+        return Err(
+            "not a PDQ checkpoint (no format = \"pdq-checkpoint\" attribute; a frame file?)".into(),
+        );
     }
     let version = attr_u64(&a, "version")?;
     if version != VERSION as u64 {
-        return Err(format!("checkpoint format version {version}, this pdq reads {VERSION}"));
+        return Err(format!(
+            "checkpoint format version {version}, this pdq reads {VERSION}"
+        ));
     }
     let n = attr_u64(&a, "particles")? as usize;
     let schema = attr_string(&a, "schema")?;
@@ -511,12 +548,12 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
         let d = f
             .dataset(name)
             .map_err(|e| format!("dataset '{name}' is missing or unreadable ({e})"))?;
-        let shape = d
-            .shape()
-            .map_err(|e| format!("dataset '{name}': {e}"))?;
+        let shape = d.shape().map_err(|e| format!("dataset '{name}': {e}"))?;
         if let Some(c) = cols {
             if shape.len() != 2 || shape[1] != c {
-                return Err(format!("dataset '{name}' has shape {shape:?}, expected [_, {c}]"));
+                return Err(format!(
+                    "dataset '{name}' has shape {shape:?}, expected [_, {c}]"
+                ));
             }
         }
         Ok(d)
@@ -574,7 +611,10 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
     } else {
         read_f64("history", lb as u64, Some(history_pairs.len()))?
     };
-    if broken.iter().chain(&history_pairs).any(|&(a, b)| a as usize >= n || b as usize >= n || a >= b)
+    if broken
+        .iter()
+        .chain(&history_pairs)
+        .any(|&(a, b)| a as usize >= n || b as usize >= n || a >= b)
         || broken.windows(2).any(|w| w[0] >= w[1])
         || history_pairs.windows(2).any(|w| w[0] >= w[1])
     {
@@ -597,7 +637,9 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
         history,
     };
     if checksum(&c) != attr_u64(&a, "checksum")? {
-        return Err("its data do not match the checksum written with them (the file is damaged)".into());
+        return Err(
+            "its data do not match the checksum written with them (the file is damaged)".into(),
+        );
     }
     Ok(c)
 }
@@ -611,7 +653,7 @@ pub fn integrator(name: &str) -> Option<Integrator> {
 
 /// `pdq info FILE`: what a frame or checkpoint holds.
 pub fn info(path: &Path) -> Result<String, String> {
-    let f = std::panic::catch_unwind(|| hdf5_pure::File::open(path))
+    let f = quietly(|| hdf5_pure::File::open(path))
         .map_err(|_| format!("{}: the file is damaged", path.display()))?
         .map_err(|e| format!("{}: not a readable HDF5 file ({e})", path.display()))?;
     let attrs = f
@@ -622,17 +664,23 @@ pub fn info(path: &Path) -> Result<String, String> {
         return Checkpoint::read(path).map(|c| c.describe());
     }
     // A frame: step, time, and its arrays.
-    let step = attr_u64(&attrs, "step").map_err(|e| format!("{}: not a PDQ frame or checkpoint ({e})", path.display()))?;
+    let step = attr_u64(&attrs, "step")
+        .map_err(|e| format!("{}: not a PDQ frame or checkpoint ({e})", path.display()))?;
     let time = attr_f64(&attrs, "time").map_err(|e| format!("{}: {e}", path.display()))?;
     let model = attr_string(&attrs, "model").unwrap_or_default();
     let mut s = format!("frame of model '{model}'\nstep       {step}\ntime       {time:.10e}\n");
     let mut arrays = Vec::new();
     let mut particles = 0;
     let mut max_damage = 0.0f64;
-    let mut names = f.root().datasets().map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut names = f
+        .root()
+        .datasets()
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     names.sort();
     for name in names {
-        let d = f.dataset(&name).map_err(|e| format!("{}: {e}", path.display()))?;
+        let d = f
+            .dataset(&name)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         let shape = d.shape().map_err(|e| format!("{}: {e}", path.display()))?;
         if name == "points" {
             particles = shape.first().copied().unwrap_or(0);

@@ -8,9 +8,9 @@ pub mod analysis;
 pub mod attributes;
 pub mod bench;
 pub mod bonds;
-pub mod checkpoint;
 pub mod boundary;
 pub mod cells;
+pub mod checkpoint;
 pub mod comm;
 #[cfg(feature = "mpi")]
 pub mod comm_mpi;

@@ -28,17 +28,26 @@ impl History {
         })
     }
 
-    /// Continues the history of a restarted run: rows up to `step` are kept (rows written
-    /// after the checkpoint the run resumes from are dropped), and new rows follow them.
-    pub fn resume(path: &Path, columns: &[String], step: u64) -> std::io::Result<History> {
+    /// Continues the history of a restarted run: the rows of steps up to `step` that are on
+    /// the schedule (multiples of `every`) are kept, so that the file ends up as an
+    /// uninterrupted run's would be (rows written after the checkpoint, and the final row of a
+    /// run that was then extended, are dropped); new rows follow them.
+    pub fn resume(
+        path: &Path,
+        columns: &[String],
+        step: u64,
+        every: u64,
+    ) -> std::io::Result<History> {
         let old = std::fs::read_to_string(path).unwrap_or_default();
         let mut kept = format!("{}\n", columns.join(","));
         for line in old.lines().skip(1) {
             let s: Option<f64> = line.split(',').next().and_then(|v| v.parse().ok());
             match s {
                 Some(s) if s <= step as f64 => {
-                    kept.push_str(line);
-                    kept.push('\n');
+                    if (s as u64).is_multiple_of(every.max(1)) {
+                        kept.push_str(line);
+                        kept.push('\n');
+                    }
                 }
                 _ => break,
             }
@@ -129,18 +138,21 @@ impl Frames {
         })
     }
 
-    /// Continues the time series of a restarted run: the frames of steps up to `step` that
-    /// are on disk are listed again; later ones (written after the checkpoint the run resumes
-    /// from) are left out and overwritten when reached.
-    pub fn resume(dir: &Path, step: u64) -> Result<Frames, String> {
+    /// Continues the time series of a restarted run: the frames on the schedule (multiples of
+    /// `every`) up to `step` that are on disk are listed again; later ones (written after the
+    /// checkpoint the run resumes from) are left out and overwritten when reached.
+    pub fn resume(dir: &Path, step: u64, every: u64) -> Result<Frames, String> {
         let mut frames = Frames::new(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         let mut steps: Vec<u64> = std::fs::read_dir(dir.join("frames"))
             .map_err(|e| format!("{}: {e}", dir.display()))?
             .filter_map(|e| {
                 let name = e.ok()?.file_name().into_string().ok()?;
-                name.strip_prefix("frame_")?.strip_suffix(".h5")?.parse().ok()
+                name.strip_prefix("frame_")?
+                    .strip_suffix(".h5")?
+                    .parse()
+                    .ok()
             })
-            .filter(|&s| s <= step)
+            .filter(|&s: &u64| s <= step && s.is_multiple_of(every.max(1)))
             .collect();
         steps.sort_unstable();
         for s in steps {
@@ -188,7 +200,10 @@ impl Frames {
         b.set_attr("step", hdf5_pure::AttrValue::U64(step));
         b.set_attr("time", hdf5_pure::AttrValue::F64(time));
         b.set_attr("model", hdf5_pure::AttrValue::String(M::NAME.into()));
-        b.set_attr("broken_bonds", hdf5_pure::AttrValue::U64(broken_bonds as u64));
+        b.set_attr(
+            "broken_bonds",
+            hdf5_pure::AttrValue::U64(broken_bonds as u64),
+        );
         let points: Vec<f64> = (0..n).flat_map(|i| p.pos(i)).collect();
         b.create_dataset("points")
             .with_f64_data(&points)
@@ -213,7 +228,7 @@ impl Frames {
             }
         }
         debug_assert!(arrays.iter().all(|a| !a.name().is_empty()));
-        write_atomically(&path, b)?;
+        write_atomically(&path, b, None)?;
         self.entries.retain(|e| e.step < step);
         self.entries.push(FrameEntry {
             step,
@@ -311,18 +326,31 @@ fn read_entry(path: &Path, step: u64) -> Result<FrameEntry, String> {
 
 /// Writes an HDF5 file under a temporary name, syncs it and renames it into place, so that a
 /// reader (or a run killed while writing) never sees a partial file under the real name.
-pub fn write_atomically(path: &Path, b: hdf5_pure::FileBuilder) -> std::io::Result<()> {
-    let name = path
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or("file");
+///
+/// `pause_midway` stops halfway through the temporary file for that long: the tests use it to
+/// kill a run in the middle of writing a checkpoint.
+pub fn write_atomically(
+    path: &Path,
+    b: hdf5_pure::FileBuilder,
+    pause_midway: Option<std::time::Duration>,
+) -> std::io::Result<()> {
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("file");
     let tmp = path.with_file_name(format!(".{name}.tmp"));
     let bytes = b
         .finish()
         .map_err(|e| std::io::Error::other(format!("HDF5: {e}")))?;
     {
         let mut f = File::create(&tmp)?;
-        f.write_all(&bytes)?;
+        match pause_midway {
+            Some(pause) => {
+                let half = bytes.len() / 2;
+                f.write_all(&bytes[..half])?;
+                f.sync_all()?;
+                std::thread::sleep(pause);
+                f.write_all(&bytes[half..])?;
+            }
+            None => f.write_all(&bytes)?,
+        }
         f.sync_all()?;
     }
     std::fs::rename(&tmp, path)?;

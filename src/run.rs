@@ -291,7 +291,7 @@ fn drive<M: Model>(
     let first = plan.first_step;
     if root {
         let h = if first > 0 {
-            History::resume(&dir.join("history.csv"), &plan.columns, first)
+            History::resume(&dir.join("history.csv"), &plan.columns, first, plan.every)
         } else {
             History::create(&dir.join("history.csv"), &plan.columns)
         };
@@ -301,7 +301,7 @@ fn drive<M: Model>(
         }
         if plan.frames_every > 0 && error.is_none() {
             let f = if first > 0 {
-                Frames::resume(dir, first)
+                Frames::resume(dir, first, plan.frames_every)
             } else {
                 Frames::new(dir).map_err(io)
             };
@@ -335,8 +335,7 @@ fn drive<M: Model>(
         // A restarted run has the row and frame of its first step from before.
         let again = first > 0 && step == first;
         let want_row = (step % plan.every == 0 || last) && !again;
-        let want_frame =
-            plan.frames_every > 0 && (step % plan.frames_every == 0 || last) && !again;
+        let want_frame = plan.frames_every > 0 && (step % plan.frames_every == 0 || last) && !again;
         if want_row || want_frame {
             let t = Instant::now();
             if any_failed(&mut cube, error.is_some()) {
@@ -355,8 +354,7 @@ fn drive<M: Model>(
             if want_frame {
                 gather_frame(&mut cube, &damage, &mut store);
                 if let (Some(f), Some(s)) = (frames.as_mut(), store.as_ref()) {
-                    if let Err(e) = f.write(step, cube.sim.time, &s.particles, &s.damage, broken)
-                    {
+                    if let Err(e) = f.write(step, cube.sim.time, &s.particles, &s.damage, broken) {
                         error = Some(io(e));
                     }
                 }
@@ -366,8 +364,8 @@ fn drive<M: Model>(
         progress.update(step, broken);
         if step > first {
             // Every step: all workers must see a signal at the same step.
-            let clock_due = ck.minutes > 0.0
-                && last_checkpoint.elapsed().as_secs_f64() >= 60.0 * ck.minutes;
+            let clock_due =
+                ck.minutes > 0.0 && last_checkpoint.elapsed().as_secs_f64() >= 60.0 * ck.minutes;
             let (stop, clock_due) =
                 agree_on_stop(&mut cube, crate::signals::requested(), clock_due);
             let due = stop
@@ -383,10 +381,7 @@ fn drive<M: Model>(
                             checkpoints.push((path, size, t.elapsed().as_secs_f64()))
                         }
                         Err(e) => {
-                            error = Some(format!(
-                                "writing checkpoint in {}: {e}",
-                                ck.dir.display()
-                            ))
+                            error = Some(format!("writing checkpoint in {}: {e}", ck.dir.display()))
                         }
                     }
                 }
@@ -629,7 +624,7 @@ fn run_setup<M: Model>(
         .output
         .clone()
         .unwrap_or_else(|| scene.output.directory.clone());
-    let scene_hash = checkpoint::scene_hash(&setup);
+    let scene_hash = checkpoint::scene_hash(&setup, scene);
     let resume = match opts.restart.as_ref().or(scene.output.restart.as_ref()) {
         Some(from) => Some(resume_from(&mut setup, from, scene_hash)?),
         None => None,

@@ -1,0 +1,406 @@
+//! Checkpoints and restarts: a run that stops and resumes ends exactly where one that never
+//! stopped ends; a restart on another layout breaks the same bonds; a run killed while writing
+//! a checkpoint, or stopped by SIGTERM, resumes; damaged or foreign checkpoints are refused.
+
+use pdq::checkpoint::Checkpoint;
+use pdq::deck;
+use pdq::decomposition::{Procs, Walls};
+use pdq::run::{run, RunOptions, Summary};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+mod common;
+use common::max_relative_difference;
+
+const PULL: &str = include_str!("decks/notched_pull.toml");
+
+/// The notched pull deck (500 steps, cracks) with a checkpoint every 250 steps.
+fn pull_deck(model: &str) -> String {
+    let text = if model == "pmb" {
+        PULL.to_string()
+    } else {
+        common::model_pull_deck(model)
+    };
+    assert!(text.contains("final_state = true"));
+    text.replace(
+        "final_state = true",
+        "final_state = true\ncheckpoint_every = 250",
+    )
+}
+
+fn out_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("pdq-ckpt-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn run_deck(text: &str, dir: &Path, opts: RunOptions) -> Result<Summary, String> {
+    let scene = deck::parse(text, "pull.toml", "pull").unwrap();
+    run(
+        &scene,
+        &RunOptions {
+            output: Some(dir.to_path_buf()),
+            quiet: true,
+            ..opts
+        },
+    )
+}
+
+fn layout(threads: usize, procs: [usize; 3]) -> RunOptions {
+    RunOptions {
+        threads: Some(threads),
+        procs: Some(Procs::Given(procs)),
+        walls: Some(Walls::Whole),
+        ..Default::default()
+    }
+}
+
+fn read(dir: &Path, file: &str) -> String {
+    std::fs::read_to_string(dir.join(file)).unwrap()
+}
+
+#[test]
+fn a_restarted_run_ends_bit_identical_to_one_that_never_stopped() {
+    for (model, threads, procs) in [
+        ("pmb", 1, [1, 1, 1]),
+        ("pmb", 2, [2, 1, 1]),
+        ("lps", 2, [2, 1, 1]),
+        ("micropolar", 1, [1, 1, 1]),
+        ("thermal", 1, [1, 1, 1]),
+    ] {
+        let text = pull_deck(model);
+        let straight = out_dir(&format!("{model}-{threads}-straight"));
+        let s = run_deck(&text, &straight, layout(threads, procs)).unwrap();
+        assert!(s.broken > 0, "{model}: the pull must crack");
+        let resumed = out_dir(&format!("{model}-{threads}-resumed"));
+        let first = run_deck(
+            &text,
+            &resumed,
+            RunOptions {
+                steps: Some(250),
+                ..layout(threads, procs)
+            },
+        )
+        .unwrap();
+        assert_eq!(first.checkpoints.len(), 1);
+        let r = run_deck(
+            &text,
+            &resumed,
+            RunOptions {
+                restart: Some(resumed.join("checkpoints")),
+                ..layout(threads, procs)
+            },
+        )
+        .unwrap();
+        assert_eq!((r.first_step, r.steps), (250, 500));
+        for file in ["final_positions.csv", "broken_bonds.csv", "history.csv"] {
+            assert!(
+                read(&straight, file) == read(&resumed, file),
+                "{model} on {threads} threads: {file} differs after the restart"
+            );
+        }
+        // The final checkpoints hold the same bytes of state: positions, velocities, forces,
+        // broken bonds and bond histories.
+        let a = Checkpoint::read(&straight.join("checkpoints/checkpoint_00000500.h5")).unwrap();
+        let b = Checkpoint::read(&resumed.join("checkpoints/checkpoint_00000500.h5")).unwrap();
+        assert!(a == b, "{model}: the final checkpoints differ");
+        eprintln!(
+            "{model}, {threads} thread(s): 500 straight = 250 + restart + 250, {} broken bonds, bit-identical",
+            s.broken
+        );
+        let _ = std::fs::remove_dir_all(straight);
+        let _ = std::fs::remove_dir_all(resumed);
+    }
+}
+
+#[test]
+fn a_checkpoint_from_one_procube_resumes_on_four() {
+    let text = pull_deck("pmb");
+    let straight = out_dir("layout-straight");
+    let s = run_deck(&text, &straight, layout(1, [1, 1, 1])).unwrap();
+    let dir = out_dir("layout-resumed");
+    run_deck(
+        &text,
+        &dir,
+        RunOptions {
+            steps: Some(250),
+            ..layout(1, [1, 1, 1])
+        },
+    )
+    .unwrap();
+    let r = run_deck(
+        &text,
+        &dir,
+        RunOptions {
+            restart: Some(dir.join("checkpoints/checkpoint_00000250.h5")),
+            ..layout(4, [2, 2, 1])
+        },
+    )
+    .unwrap();
+    assert_eq!(s.broken_pairs, r.broken_pairs, "different bonds broke");
+    let d = max_relative_difference(&s.positions, &r.positions);
+    eprintln!(
+        "1x1x1 -> 2x2x1 at step 250: {} broken bonds, the same set; positions within {d:.1e}",
+        r.broken
+    );
+    assert!(d <= 1e-12, "positions differ by {d:e}");
+    let _ = std::fs::remove_dir_all(straight);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+fn pdq() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_pdq"))
+}
+
+/// Writes `text` as a deck file in `dir` and returns its path.
+fn deck_file(dir: &Path, text: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join("pull.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn wait_for(what: &str, timeout: Duration, mut ready: impl FnMut() -> bool) {
+    let start = Instant::now();
+    while !ready() {
+        assert!(start.elapsed() < timeout, "timed out waiting for {what}");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn a_run_killed_while_writing_a_checkpoint_resumes_from_the_previous_one() {
+    let work = out_dir("kill");
+    let text = pull_deck("pmb").replace("checkpoint_every = 250", "checkpoint_every = 100");
+    let deck = deck_file(&work, &text);
+    let out = work.join("out");
+    // Checkpoints at 100 and 200.
+    let ok = pdq()
+        .arg("run")
+        .arg(&deck)
+        .args(["--quiet", "--steps", "200", "--output"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    // Resume, and kill the run halfway through writing the checkpoint of step 300.
+    let mut child = pdq()
+        .arg("run")
+        .arg(&deck)
+        .args(["--quiet", "--output"])
+        .arg(&out)
+        .arg("--restart")
+        .arg(&out)
+        .env("PDQ_CHECKPOINT_PAUSE_MS", "30000")
+        .spawn()
+        .unwrap();
+    let tmp = out.join("checkpoints/.checkpoint_00000300.h5.tmp");
+    wait_for(
+        "the checkpoint of step 300 to be half written",
+        Duration::from_secs(120),
+        || {
+            tmp.exists()
+                && std::fs::metadata(&tmp)
+                    .map(|m| m.len() > 0)
+                    .unwrap_or(false)
+        },
+    );
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    assert!(!out.join("checkpoints/checkpoint_00000300.h5").exists());
+    // The half-written file is not a checkpoint; the previous one loads.
+    assert!(Checkpoint::read(&tmp).is_err());
+    let (path, c) = pdq::checkpoint::resolve(&out).unwrap();
+    assert_eq!(c.step, 200, "resumes from {}", path.display());
+    let resumed = pdq()
+        .arg("run")
+        .arg(&deck)
+        .args(["--quiet", "--output"])
+        .arg(&out)
+        .arg("--restart")
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(resumed.success());
+    let straight = work.join("straight");
+    let ok = pdq()
+        .arg("run")
+        .arg(&deck)
+        .args(["--quiet", "--output"])
+        .arg(&straight)
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    for file in ["final_positions.csv", "broken_bonds.csv", "history.csv"] {
+        assert!(read(&straight, file) == read(&out, file), "{file} differs");
+    }
+    let _ = std::fs::remove_dir_all(work);
+}
+
+#[test]
+fn sigterm_writes_a_checkpoint_and_the_run_resumes_from_it() {
+    let work = out_dir("term");
+    // No checkpoints on a schedule: the signal alone makes one.
+    let text = pull_deck("pmb").replace("checkpoint_every = 250", "");
+    let deck = deck_file(&work, &text);
+    let out = work.join("out");
+    let child = pdq()
+        .arg("run")
+        .arg(&deck)
+        .args(["--quiet", "--steps", "100000000", "--output"])
+        .arg(&out)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until it is stepping (a few history rows), then ask it to stop.
+    wait_for(
+        "the run to start stepping",
+        Duration::from_secs(120),
+        || {
+            std::fs::read_to_string(out.join("history.csv"))
+                .map(|h| h.lines().count() > 3)
+                .unwrap_or(false)
+        },
+    );
+    let kill = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let done = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&done.stderr);
+    assert_eq!(
+        done.status.code(),
+        Some(pdq::signals::EXIT_INTERRUPTED as i32),
+        "{stderr}"
+    );
+    assert!(stderr.contains("--restart"), "says how to resume: {stderr}");
+    let (_, c) = pdq::checkpoint::resolve(&out).unwrap();
+    assert!(c.step > 0);
+    eprintln!(
+        "SIGTERM: stopped at step {} with a checkpoint; {stderr}",
+        c.step
+    );
+    // Resuming to a few steps further matches a run that went there straight.
+    let end = (c.step + 50).to_string();
+    let resumed = pdq()
+        .arg("run")
+        .arg(&deck)
+        .args(["--quiet", "--steps", &end, "--output"])
+        .arg(&out)
+        .arg("--restart")
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(resumed.success());
+    let straight = work.join("straight");
+    let ok = pdq()
+        .arg("run")
+        .arg(&deck)
+        .args(["--quiet", "--steps", &end, "--output"])
+        .arg(&straight)
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    for file in ["final_positions.csv", "broken_bonds.csv"] {
+        assert!(read(&straight, file) == read(&out, file), "{file} differs");
+    }
+    let _ = std::fs::remove_dir_all(work);
+}
+
+#[test]
+fn foreign_truncated_and_damaged_checkpoints_are_refused() {
+    let text = pull_deck("pmb");
+    let dir = out_dir("bad");
+    run_deck(
+        &text,
+        &dir,
+        RunOptions {
+            steps: Some(250),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let good = dir.join("checkpoints/checkpoint_00000250.h5");
+    let restart = |deck: &str, from: &Path| -> String {
+        run_deck(
+            deck,
+            &dir.join("again"),
+            RunOptions {
+                restart: Some(from.to_path_buf()),
+                ..Default::default()
+            },
+        )
+        .err()
+        .expect("the restart must be refused")
+    };
+    // Another model.
+    let e = restart(&pull_deck("lps"), &good);
+    assert!(e.contains("model 'pmb'") && e.contains("'lps'"), "{e}");
+    // Another geometry (a wider block), and another material.
+    let wider = text.replace("max = \"30 10 10 mm\"", "max = \"31 10 10 mm\"");
+    assert_ne!(wider, text, "the deck's block changed");
+    let e = restart(&wider, &good);
+    assert!(e.contains("particles") || e.contains("geometry"), "{e}");
+    let e = restart(&text.replace("14.9 GPa", "20 GPa"), &good);
+    assert!(e.contains("materials"), "{e}");
+    // Truncated, and one byte changed in the middle.
+    let bytes = std::fs::read(&good).unwrap();
+    let cut = dir.join("truncated.h5");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let e = restart(&text, &cut);
+    assert!(e.contains("truncated.h5"), "{e}");
+    for at in [bytes.len() / 3, bytes.len() / 2, bytes.len() - 100] {
+        let mut bad = bytes.clone();
+        bad[at] ^= 0x5a;
+        let path = dir.join("damaged.h5");
+        std::fs::write(&path, &bad).unwrap();
+        let e = restart(&text, &path);
+        assert!(e.contains("damaged.h5"), "byte {at}: {e}");
+    }
+    // A frame is not a checkpoint; nor is a file that does not exist.
+    let e = restart(&text, &dir.join("history.csv"));
+    assert!(e.contains("history.csv"), "{e}");
+    let e = restart(&text, &dir.join("nothing.h5"));
+    assert!(e.contains("no such file"), "{e}");
+    eprintln!("refused: {e}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn pdq_info_describes_frames_and_checkpoints() {
+    let text = pull_deck("pmb").replace(
+        "history_every = 100",
+        "history_every = 100\nframes_every = 250",
+    );
+    let dir = out_dir("info");
+    let s = run_deck(&text, &dir, RunOptions::default()).unwrap();
+    let info = |file: &Path| {
+        let out = pdq().arg("info").arg(file).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let c = info(&dir.join("checkpoints/checkpoint_00000500.h5"));
+    assert!(c.contains("step       500"), "{c}");
+    assert!(c.contains(&format!("{} broken", s.broken)), "{c}");
+    assert!(c.contains(&format!("particles  {}", s.particles)), "{c}");
+    let f = info(&dir.join("frames/frame_00000500.h5"));
+    assert!(
+        f.contains("step       500") && f.contains("damage[1]"),
+        "{f}"
+    );
+    assert!(f.contains(&format!("{} broken", s.broken)), "{f}");
+    let out = pdq()
+        .arg("info")
+        .arg(dir.join("history.csv"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("history.csv"));
+    let _ = std::fs::remove_dir_all(dir);
+}
