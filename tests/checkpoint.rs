@@ -332,8 +332,7 @@ fn foreign_truncated_and_damaged_checkpoints_are_refused() {
                 ..Default::default()
             },
         )
-        .err()
-        .expect("the restart must be refused")
+        .expect_err("the restart must be refused")
     };
     // Another model.
     let e = restart(&pull_deck("lps"), &good);
