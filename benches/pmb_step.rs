@@ -13,6 +13,7 @@ fn main() {
         n: 40,
         peer: false,
         repeat: 5,
+        checkpoint: true,
     };
     match pdq::bench::run(&opts) {
         Ok(s) => print!("{s}"),

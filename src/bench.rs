@@ -34,6 +34,8 @@ pub struct BenchOptions {
     pub repeat: usize,
     /// Times through the thread counts (medians are reported when more than one).
     pub rounds: usize,
+    /// Also time writing one checkpoint of the scene against 100 steps (one thread).
+    pub checkpoint: bool,
 }
 
 const SPACING: f64 = 0.001;
@@ -217,6 +219,39 @@ impl ModelVisitor for MpiVisit<'_> {
     }
 }
 
+/// The time to gather and write a checkpoint of the scene (after 100 steps on one thread),
+/// against the time of those 100 steps.
+fn checkpoint_line<M: Model>(
+    setup: &setup::Setup<M>,
+    opts: &BenchOptions,
+) -> Result<String, String> {
+    let layout = parallel::layout(setup, &Procs::Given([1, 1, 1]), 1, opts.walls)?;
+    let mut cube = parallel::thread_cubes(setup, &layout).remove(0);
+    cube.start();
+    let steps = 100;
+    let t = std::time::Instant::now();
+    for _ in 0..steps {
+        cube.sim.advance();
+    }
+    let step_seconds = t.elapsed().as_secs_f64();
+    let dir = std::env::temp_dir().join(format!("pdq-bench-checkpoint-{}", std::process::id()));
+    let t = std::time::Instant::now();
+    let c = crate::checkpoint::Checkpoint::gather(&mut cube, 0, "<bench>")
+        .ok_or("the checkpoint was not gathered")?;
+    let (_, bytes) = c
+        .write(&dir, 1)
+        .map_err(|e| format!("writing a checkpoint in {}: {e}", dir.display()))?;
+    let seconds = t.elapsed().as_secs_f64();
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok(format!(
+        "bench checkpoint model={} particles={} bonds={} bytes={bytes} seconds={seconds:.3} steps={steps} step_seconds={step_seconds:.3} percent_of_steps={:.1}\n",
+        M::NAME,
+        setup.sim.particles.n_owned,
+        cube.sim.bonds.len(),
+        100.0 * seconds / step_seconds
+    ))
+}
+
 /// `mpirun -np ranks`, allowed to run as root (containers) and on more ranks than cores.
 fn mpirun(ranks: usize) -> Command {
     let mut c = Command::new("mpirun");
@@ -265,6 +300,9 @@ fn bench_setup<M: Model>(
 ) -> Result<(String, f64), String> {
     let n = setup.sim.particles.n_owned;
     let mut out = String::new();
+    if opts.checkpoint {
+        out.push_str(&checkpoint_line(&setup, opts)?);
+    }
     // Runs alternate through the thread counts `rounds` times; each speed-up is taken against
     // the one-thread run just before it, so a slow spell of a shared machine hits both.
     let mut last_one = None;

@@ -84,6 +84,9 @@ enum Cmd {
         /// Times through the thread counts, alternating; medians are printed when above 1.
         #[arg(long, default_value_t = 1)]
         rounds: usize,
+        /// Also time writing a checkpoint of the scene against 100 steps (one thread).
+        #[arg(long)]
+        checkpoint: bool,
     },
 }
 
@@ -146,6 +149,7 @@ fn main() -> ExitCode {
             peer,
             repeat,
             rounds,
+            checkpoint,
         } => bench::run(&bench::BenchOptions {
             model,
             threads,
@@ -162,6 +166,7 @@ fn main() -> ExitCode {
             peer,
             repeat,
             rounds,
+            checkpoint,
         })
         .map(|s| print!("{s}")),
     };

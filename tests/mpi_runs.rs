@@ -189,9 +189,10 @@ fn a_bad_layout_under_mpi_says_what_to_change() {
 fn restarts_under_mpi() {
     let work = out_dir("restart");
     std::fs::create_dir_all(&work).unwrap();
-    let text = std::fs::read_to_string(DECK)
-        .unwrap()
-        .replace("final_state = true", "final_state = true\ncheckpoint_every = 250");
+    let text = std::fs::read_to_string(DECK).unwrap().replace(
+        "final_state = true",
+        "final_state = true\ncheckpoint_every = 250",
+    );
     let deck_path = work.join("pull.toml");
     std::fs::write(&deck_path, &text).unwrap();
     let straight = work.join("straight");
@@ -220,12 +221,7 @@ fn restarts_under_mpi() {
     )
     .unwrap();
     let from = one.join("checkpoints/checkpoint_00000250.h5");
-    mpirun_deck(
-        2,
-        &deck_path,
-        &["--restart", from.to_str().unwrap()],
-        &one,
-    );
+    mpirun_deck(2, &deck_path, &["--restart", from.to_str().unwrap()], &one);
     let (pa, ba) = read_final(&straight);
     let (pb, bb) = read_final(&one);
     assert_eq!(ba, bb, "different bonds broke");
