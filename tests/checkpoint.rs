@@ -241,14 +241,21 @@ fn a_run_killed_while_writing_a_checkpoint_resumes_from_the_previous_one() {
 #[test]
 fn sigterm_writes_a_checkpoint_and_the_run_resumes_from_it() {
     let work = out_dir("term");
-    // No checkpoints on a schedule: the signal alone makes one.
+    // No checkpoints on a schedule: the signal alone makes one. Two procCubes agree on it.
     let text = pull_deck("pmb").replace("checkpoint_every = 250", "");
     let deck = deck_file(&work, &text);
     let out = work.join("out");
     let child = pdq()
         .arg("run")
         .arg(&deck)
-        .args(["--quiet", "--steps", "100000000", "--output"])
+        .args([
+            "--quiet",
+            "--threads",
+            "2",
+            "--steps",
+            "100000000",
+            "--output",
+        ])
         .arg(&out)
         .stderr(Stdio::piped())
         .spawn()
@@ -287,7 +294,7 @@ fn sigterm_writes_a_checkpoint_and_the_run_resumes_from_it() {
     let resumed = pdq()
         .arg("run")
         .arg(&deck)
-        .args(["--quiet", "--steps", &end, "--output"])
+        .args(["--quiet", "--threads", "2", "--steps", &end, "--output"])
         .arg(&out)
         .arg("--restart")
         .arg(&out)
@@ -298,7 +305,7 @@ fn sigterm_writes_a_checkpoint_and_the_run_resumes_from_it() {
     let ok = pdq()
         .arg("run")
         .arg(&deck)
-        .args(["--quiet", "--steps", &end, "--output"])
+        .args(["--quiet", "--threads", "2", "--steps", &end, "--output"])
         .arg(&straight)
         .status()
         .unwrap();
@@ -401,5 +408,25 @@ fn pdq_info_describes_frames_and_checkpoints() {
         .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("history.csv"));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn checkpoints_on_the_wall_clock_keep_the_newest() {
+    let text = pull_deck("pmb").replace(
+        "checkpoint_every = 250",
+        "checkpoint_minutes = 0.00002\ncheckpoint_keep = 2",
+    );
+    let dir = out_dir("clock");
+    let s = run_deck(&text, &dir, RunOptions::default()).unwrap();
+    let on_disk = std::fs::read_dir(dir.join("checkpoints")).unwrap().count();
+    eprintln!(
+        "every 1.2 ms of wall time: {} checkpoints written, {on_disk} kept",
+        s.checkpoints.len()
+    );
+    assert!(s.checkpoints.len() > 2, "{} written", s.checkpoints.len());
+    assert_eq!(on_disk, 2);
+    let (_, c) = pdq::checkpoint::resolve(&dir).unwrap();
+    assert_eq!(c.step, 500, "the last step always gets one");
     let _ = std::fs::remove_dir_all(dir);
 }
