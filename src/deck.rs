@@ -67,6 +67,19 @@ struct DeckFile {
     probe: Vec<Spanned<ProbeSection>>,
     #[serde(default)]
     parallel: Option<Spanned<ParallelSection>>,
+    #[serde(default)]
+    solver: Option<Spanned<SolverSection>>,
+}
+
+/// `[solver]`: explicit time stepping (the default) or quasi-static adaptive dynamic
+/// relaxation.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SolverSection {
+    kind: String,
+    load_steps: Option<u64>,
+    tolerance: Option<f64>,
+    max_iterations: Option<u64>,
 }
 
 /// `procs` is `[nx, ny, nz]` or `"auto"`.
@@ -372,6 +385,21 @@ pub struct InitialSpec {
     pub temperature: Option<f64>,
 }
 
+/// How the deck's loads are followed in time.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SolverSpec {
+    /// Explicit time integration (`[time]` integrator).
+    Explicit,
+    /// Adaptive dynamic relaxation to equilibrium at each of `load_steps` equal steps of the
+    /// loads' time history (THEORY.md §5).
+    Relaxation {
+        load_steps: u64,
+        /// Converged when |residual force| ≤ tolerance × |applied force and reactions|.
+        tolerance: f64,
+        max_iterations: u64,
+    },
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct OutputSpec {
     pub directory: PathBuf,
@@ -430,6 +458,9 @@ pub struct Scene {
     pub initial: Vec<InitialSpec>,
     pub output: OutputSpec,
     pub probes: Vec<ProbeSpec>,
+    pub solver: SolverSpec,
+    /// Deck line of `[solver]` (0 if absent), for messages.
+    pub solver_line: usize,
 }
 
 impl Scene {
@@ -818,6 +849,50 @@ impl Converter {
             return self.err(out_line, "[output] checkpoint_keep must be ≥ 1");
         }
         let parallel = self.parallel(deck.parallel.as_ref())?;
+        let (solver, solver_line) = match &deck.solver {
+            None => (SolverSpec::Explicit, 0),
+            Some(sec) => {
+                let line = self.line_of(sec);
+                let s = sec.get_ref();
+                let solver = match s.kind.as_str() {
+                    "explicit" => {
+                        if s.load_steps.is_some()
+                            || s.tolerance.is_some()
+                            || s.max_iterations.is_some()
+                        {
+                            return self.err(line, "[solver] load_steps, tolerance and max_iterations belong to kind = \"adr\"");
+                        }
+                        SolverSpec::Explicit
+                    }
+                    "adr" => {
+                        let load_steps = s.load_steps.unwrap_or(10);
+                        let tolerance = s.tolerance.unwrap_or(1e-4);
+                        let max_iterations = s.max_iterations.unwrap_or(100_000);
+                        if load_steps == 0 || max_iterations == 0 {
+                            return self
+                                .err(line, "[solver] load_steps and max_iterations must be ≥ 1");
+                        }
+                        if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
+                            return self.err(line, format!("[solver] tolerance must lie in (0, 1), the deck gives {tolerance}"));
+                        }
+                        SolverSpec::Relaxation {
+                            load_steps,
+                            tolerance,
+                            max_iterations,
+                        }
+                    }
+                    other => {
+                        return self.err(
+                            line,
+                            format!(
+                                "[solver] unknown kind '{other}' (use \"explicit\" or \"adr\")"
+                            ),
+                        )
+                    }
+                };
+                (solver, line)
+            }
+        };
         let mut periodic = [false; 3];
         for a in &lattice_periodic {
             match a.as_str() {
@@ -898,6 +973,8 @@ impl Converter {
             initial,
             output,
             probes,
+            solver,
+            solver_line,
         })
     }
 

@@ -3,7 +3,7 @@
 use crate::attributes::Attributes;
 use crate::checkpoint::{self, Checkpoint};
 use crate::comm::{f64s, Reduce, Team, Transport};
-use crate::deck::Scene;
+use crate::deck::{Scene, SolverSpec};
 use crate::decomposition::{Layout, Procs, Walls};
 use crate::model::{Model, ModelVisitor};
 use crate::output::{Frames, History, Progress};
@@ -43,6 +43,11 @@ pub struct Summary {
     pub checkpoints: Vec<(PathBuf, u64, f64)>,
     /// The step the run started from (a restart's checkpoint step, else 0).
     pub first_step: u64,
+    /// Force evaluations of the step loop: one per step explicitly, the iterations of every
+    /// load step under relaxation.
+    pub force_evaluations: u64,
+    /// Under relaxation: load steps that reached the tolerance within `max_iterations`.
+    pub converged_steps: u64,
 }
 
 /// Options the command line may set over the deck.
@@ -97,6 +102,10 @@ fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
         for k in ["ux", "uy", "uz"] {
             c.push(format!("{name}_{k}"));
         }
+    }
+    if let SolverSpec::Relaxation { .. } = setup.solver {
+        c.push("iterations".into());
+        c.push("residual".into());
     }
     c
 }
@@ -238,6 +247,8 @@ struct Plan {
     layout: String,
     /// The step the loop starts from: 0, or the step of the checkpoint it resumes.
     first_step: u64,
+    /// Relaxation: fictitious masses by global id, tolerance, iteration limit.
+    relaxation: Option<(Vec<f64>, f64, u64)>,
     checkpoints: CheckpointPlan,
 }
 
@@ -315,6 +326,8 @@ fn drive<M: Model>(
     let mut checkpoints: Vec<(PathBuf, u64, f64)> = Vec::new();
     let mut last_checkpoint = Instant::now();
     let mut interrupted = None;
+    let (mut evaluations, mut converged) = (0u64, 0u64);
+    let mut relaxed: Option<crate::relaxation::Relaxed> = None;
     let workers = cube.sim.exchange.transport().size();
     let mut progress = Progress::new(plan.steps, root && plan.progress && !plan.quiet);
     let wall = Instant::now();
@@ -322,7 +335,18 @@ fn drive<M: Model>(
     let mut shuffles = 0u64;
     for step in first..=plan.steps {
         if step > first {
-            cube.sim.advance();
+            match &plan.relaxation {
+                None => {
+                    cube.sim.advance();
+                    evaluations += 1;
+                }
+                Some((mass, tolerance, max_iterations)) => {
+                    let r = cube.relax_step(mass, *tolerance, *max_iterations);
+                    evaluations += r.iterations;
+                    converged += r.converged as u64;
+                    relaxed = Some(r);
+                }
+            }
             if plan.shuffle_every > 0 && step % plan.shuffle_every == 0 {
                 let t = Instant::now();
                 // Every worker sees the same scene here, so all fail alike.
@@ -344,7 +368,12 @@ fn drive<M: Model>(
             }
             let damage = cube.damage();
             if want_row {
-                let r = row(&mut cube, &damage, plan.n_probes);
+                let mut r = row(&mut cube, &damage, plan.n_probes);
+                if plan.relaxation.is_some() {
+                    let last = relaxed.unwrap_or_default();
+                    r.push(last.iterations as f64);
+                    r.push(last.residual);
+                }
                 broken = r[5] as usize;
                 if let Some(h) = history.as_mut() {
                     if let Err(e) = h.row(&r) {
@@ -531,6 +560,8 @@ fn drive<M: Model>(
         interrupted,
         checkpoints,
         first_step: first,
+        force_evaluations: evaluations,
+        converged_steps: converged,
     }))
 }
 
@@ -630,6 +661,20 @@ fn run_setup<M: Model>(
         .output
         .clone()
         .unwrap_or_else(|| scene.output.directory.clone());
+    let relaxation = match setup.solver {
+        SolverSpec::Explicit => None,
+        SolverSpec::Relaxation {
+            tolerance,
+            max_iterations,
+            ..
+        } => {
+            crate::relaxation::check_model::<M>()
+                .map_err(|e| format!("{}:{}: {e}", scene.file, scene.solver_line))?;
+            let sim = &setup.sim;
+            let mass = crate::relaxation::fictitious_mass(&sim.model, &sim.particles, &sim.bonds);
+            Some((mass, tolerance, max_iterations))
+        }
+    };
     let scene_hash = checkpoint::scene_hash(&setup, scene);
     let resume = match opts.restart.as_ref().or(scene.output.restart.as_ref()) {
         Some(from) => Some(resume_from(&mut setup, from, scene_hash)?),
@@ -658,6 +703,7 @@ fn run_setup<M: Model>(
         n_probes: setup.probes.len(),
         layout: layout.describe(),
         first_step: resume.map_or(0, |c| c.step),
+        relaxation: relaxation.clone(),
         checkpoints: CheckpointPlan {
             dir: dir.join("checkpoints"),
             every: scene.output.checkpoint_every,

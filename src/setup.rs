@@ -30,6 +30,8 @@ pub struct Setup<M: Model> {
     pub partial_volume: bool,
     /// Energy surface correction factors gᵢᵏ by store index, if the deck asks for them.
     pub correction: Option<Vec<[f64; 3]>>,
+    /// Explicit stepping, or relaxation to equilibrium at each load step.
+    pub solver: crate::deck::SolverSpec,
 }
 
 /// Builds the model named by the deck and hands it to `visitor`.
@@ -176,9 +178,22 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         }
         None => scene.time.safety_factor * dt_critical,
     };
-    let steps = match scene.time.length {
+    let mut steps = match scene.time.length {
         RunLength::Steps(n) => n,
         RunLength::Duration(d) => (d / dt).ceil() as u64,
+    };
+    // Relaxation follows the loads through the same time span in `load_steps` equal steps;
+    // a "step" is then a load step and Δt its length in the loads' time.
+    let dt = match scene.solver {
+        crate::deck::SolverSpec::Relaxation { load_steps, .. } => {
+            let span = match scene.time.length {
+                RunLength::Steps(n) => n as f64 * dt,
+                RunLength::Duration(d) => d,
+            };
+            steps = load_steps;
+            span / load_steps as f64
+        }
+        crate::deck::SolverSpec::Explicit => dt,
     };
     if steps > 1_000_000_000_000 {
         return Err(scene.error(
@@ -339,6 +354,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         spacing: scene.spacing,
         partial_volume: scene.partial_volume,
         correction,
+        solver: scene.solver.clone(),
     })
 }
 

@@ -200,15 +200,13 @@ impl<M: Model> Simulation<M> {
     }
 }
 
-/// The stable time step and the particle that sets it (THEORY.md §4): for each second-order
-/// DOF the Silling–Askari bound √(2m / (V_i Σ_j V_j C_ij)), for each first-order DOF the
-/// forward-Euler bound C / (V_i Σ_j V_j K_ij) (Gershgorin: twice the diagonal bounds the
-/// largest eigenvalue). Infinite if no particle has a bond.
-pub fn stable_time_step<M: Model>(
+/// Σ_j V_j C_ij for each particle and DOF, C_ij the bond stiffness of [`Model::bond_stiffness`]:
+/// V_i times it bounds the particle's diagonal stiffness (THEORY.md §4, §5).
+pub fn stiffness_sums<M: Model>(
     model: &M,
     p: &Particles<M>,
     bonds: &BondList<M::Bond>,
-) -> (f64, usize) {
+) -> Vec<M::Force> {
     let mut sum = vec![M::Force::default(); p.len()];
     for (i, j, b) in bonds.iter() {
         let law = model.law(p.material[i], p.material[j]);
@@ -221,6 +219,19 @@ pub fn stable_time_step<M: Model>(
             *v += p.volume[i] * c[k];
         }
     }
+    sum
+}
+
+/// The stable time step and the particle that sets it (THEORY.md §4): for each second-order
+/// DOF the Silling–Askari bound √(2m / (V_i Σ_j V_j C_ij)), for each first-order DOF the
+/// forward-Euler bound C / (V_i Σ_j V_j K_ij) (Gershgorin: twice the diagonal bounds the
+/// largest eigenvalue). Infinite if no particle has a bond.
+pub fn stable_time_step<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &BondList<M::Bond>,
+) -> (f64, usize) {
+    let sum = stiffness_sums(model, p, bonds);
     let n2 = second_order::<M>();
     let mut best = (f64::INFINITY, 0);
     for (i, s) in sum.iter().enumerate().take(p.n_owned) {

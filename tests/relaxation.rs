@@ -1,0 +1,168 @@
+//! Adaptive dynamic relaxation: equilibrium at every load step (residual below the tolerance,
+//! reactions balancing the load), a linear response proportional to the load, the same answer
+//! on one and on several procCubes, for PMB, LPS and micropolar; models it cannot relax are
+//! refused.
+
+use pdq::deck;
+use pdq::decomposition::{Procs, Walls};
+use pdq::run::{run, RunOptions, Summary};
+
+/// A bar 40 × 6 × 6 mm held at x ≤ 3 mm and pulled by 10 N at x ≥ 37 mm (strain 2·10⁻⁵, so
+/// the geometric nonlinearity is of that order), in four load steps, relaxed to 10⁻⁹.
+fn bar_deck(model: &str) -> String {
+    let material = match model {
+        "micropolar" => "youngs_modulus = \"22.35 GPa\"\npoisson_ratio = 0.2\n",
+        "lps" => "bulk_modulus = \"14.9 GPa\"\npoisson_ratio = 0.3\n",
+        _ => "bulk_modulus = \"14.9 GPa\"\n",
+    };
+    format!(
+        r#"units = "SI"
+[model]
+name = "{model}"
+horizon = "3.015 mm"
+[lattice]
+spacing = "1 mm"
+[materials.rock]
+density = "2200 kg/m^3"
+{material}critical_stretch = 0.05
+[[geometry]]
+shape = "box"
+material = "rock"
+min = "0 0 0 mm"
+max = "40 6 6 mm"
+[time]
+duration = "1 ms"
+[solver]
+kind = "adr"
+load_steps = 4
+tolerance = 1e-9
+[[boundary]]
+name = "left"
+region = {{ shape = "slab", axis = "x", from = "0 mm", to = "3 mm" }}
+fixed = ["all"]
+[[load]]
+name = "pull"
+region = {{ shape = "slab", axis = "x", from = "37 mm", to = "40 mm" }}
+total_force = "10 0 0 N"
+history = {{ ramp = "1 ms" }}
+[[probe]]
+name = "tip"
+at = "39 3 3 mm"
+[output]
+progress = false
+history_every = 1
+"#
+    )
+}
+
+fn relax(model: &str, threads: usize, procs: [usize; 3]) -> (Summary, Vec<Vec<f64>>) {
+    let scene = deck::parse(&bar_deck(model), "bar.toml", "bar").unwrap();
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let k = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!(
+        "pdq-adr-{model}-{threads}-{}-{k}",
+        std::process::id()
+    ));
+    let s = run(
+        &scene,
+        &RunOptions {
+            output: Some(dir.clone()),
+            quiet: true,
+            threads: Some(threads),
+            procs: Some(Procs::Given(procs)),
+            walls: Some(Walls::Whole),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|c| *c == name).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let picked = rows
+        .iter()
+        .map(|r| {
+            [
+                "load_pull",
+                "reaction_left_x",
+                "tip_ux",
+                "iterations",
+                "residual",
+            ]
+            .iter()
+            .map(|c| r[col(c)])
+            .collect()
+        })
+        .collect();
+    let _ = std::fs::remove_dir_all(dir);
+    (s, picked)
+}
+
+#[test]
+fn each_load_step_ends_in_equilibrium_with_a_response_proportional_to_the_load() {
+    for model in ["pmb", "lps", "micropolar"] {
+        let (s, rows) = relax(model, 1, [1, 1, 1]);
+        assert_eq!(s.steps, 4);
+        assert_eq!(s.converged_steps, 4, "{model}: every load step converges");
+        let tip_at_full = rows[4][2];
+        for (k, r) in rows.iter().enumerate().skip(1) {
+            let (load, reaction, tip, iterations, residual) = (r[0], r[1], r[2], r[3], r[4]);
+            assert!(residual <= 1e-9, "{model} step {k}: residual {residual:e}");
+            // The support holds what the load pulls.
+            assert!(
+                (load + reaction).abs() <= 1e-6 * load,
+                "{model} step {k}: load {load} against reaction {reaction}"
+            );
+            // Linear elasticity, small strain: the tip moves in proportion to the load.
+            let expected = tip_at_full * k as f64 / 4.0;
+            assert!(
+                (tip - expected).abs() <= 1e-4 * tip_at_full,
+                "{model} step {k}: tip {tip:e}, proportional {expected:e}"
+            );
+            eprintln!(
+                "{model} load step {k}: {load:.0} N, tip {tip:.4e} m, {iterations} iterations, residual {residual:.1e}"
+            );
+        }
+        eprintln!(
+            "{model}: {} force evaluations for 4 load steps",
+            s.force_evaluations
+        );
+    }
+}
+
+#[test]
+fn relaxation_gives_the_same_equilibrium_on_several_procubes() {
+    let (_, one) = relax("pmb", 1, [1, 1, 1]);
+    let (_, two) = relax("pmb", 2, [2, 1, 1]);
+    let (a, b) = (one[4][2], two[4][2]);
+    eprintln!("tip on 1 procCube {a:.10e}, on 2 {b:.10e}");
+    // Both stop within the tolerance of the same equilibrium.
+    assert!((a - b).abs() <= 1e-6 * a.abs(), "{a:e} against {b:e}");
+}
+
+#[test]
+fn relaxation_refuses_a_temperature_model() {
+    let text = bar_deck("pmb")
+        .replace("name = \"pmb\"", "name = \"thermal\"")
+        .replace(
+            "bulk_modulus = \"14.9 GPa\"\n",
+            "bulk_modulus = \"14.9 GPa\"\nthermal_conductivity = 2.0\nspecific_heat = 900.0\n",
+        );
+    let scene = deck::parse(&text, "bar.toml", "bar").unwrap();
+    let e = run(
+        &scene,
+        &RunOptions {
+            quiet: true,
+            output: Some(
+                std::env::temp_dir().join(format!("pdq-adr-thermal-{}", std::process::id())),
+            ),
+            ..Default::default()
+        },
+    )
+    .expect_err("thermal cannot be relaxed");
+    assert!(e.contains("bar.toml:") && e.contains("first-order"), "{e}");
+}
