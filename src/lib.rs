@@ -33,4 +33,5 @@ pub mod signals;
 pub mod simulation;
 pub mod timing;
 pub mod units;
+pub mod validate;
 pub mod wall;

@@ -44,6 +44,23 @@ enum Cmd {
         #[arg(long)]
         restart: Option<PathBuf>,
     },
+    /// Run the validation cases against engineering formulas; write report.md.
+    Validate {
+        /// Coarse versions of every case (the default).
+        #[arg(long, conflicts_with = "full")]
+        quick: bool,
+        /// The finer resolution.
+        #[arg(long)]
+        full: bool,
+        /// Cases to run (all when none is named).
+        cases: Vec<String>,
+        /// Output directory.
+        #[arg(long, default_value = "out/validate")]
+        output: PathBuf,
+        /// Threads per case.
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+    },
     /// Print what a frame or checkpoint file holds: step, time, particles, attributes, bonds.
     Info { file: PathBuf },
     /// Check a deck: particles, bonds, memory, time step, and an estimated run time.
@@ -128,6 +145,30 @@ fn main() -> ExitCode {
                     interrupted = true;
                 }
             }),
+        Cmd::Validate {
+            quick: _,
+            full,
+            cases,
+            output,
+            threads,
+        } => pdq::validate::run_all(&pdq::validate::ValidateOptions {
+            level: if full {
+                pdq::validate::Level::Full
+            } else {
+                pdq::validate::Level::Quick
+            },
+            only: cases,
+            output,
+            threads,
+        })
+        .and_then(|(table, ok)| {
+            print!("{table}");
+            if ok {
+                Ok(())
+            } else {
+                Err("an elastic case is outside its tolerance (see the table)".into())
+            }
+        }),
         Cmd::Info { file } => pdq::checkpoint::info(&file).map(|s| print!("{s}")),
         Cmd::Check { deck: path } => deck::load(&path)
             .map_err(|e| e.to_string())

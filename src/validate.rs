@@ -1,0 +1,333 @@
+//! `pdq validate`: cases that compare PDQ with engineering formulas and report the error.
+//!
+//! A case is a deck (made here, at a coarse `--quick` or a fine `--full` resolution), a
+//! reference value from a formula (THEORY.md §7), a tolerance, and an extractor that reads the
+//! measured value from the run's output. The runner writes `report.md` with the table (case,
+//! quantity, PDQ, reference, error, particles, run time) and a PNG plot per case.
+
+use crate::deck;
+use crate::run::{self, RunOptions, Summary};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The resolution of a validation run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Level {
+    /// Coarse versions of every case: minutes on 2 cores, run in CI.
+    Quick,
+    /// Finer lattices (the thesis's resolution where the case is one of its problems).
+    Full,
+}
+
+/// Elastic cases must meet their tolerance; strength cases report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    Elastic,
+    Strength,
+}
+
+/// One validation case.
+pub struct Case {
+    pub name: String,
+    pub quantity: String,
+    pub unit: &'static str,
+    pub kind: Kind,
+    pub reference: f64,
+    /// Where the reference comes from.
+    pub formula: String,
+    pub tolerance_percent: f64,
+    pub deck: String,
+    /// The measured value from the run's summary and output directory.
+    pub extract: fn(&Summary, &Path) -> Result<f64, String>,
+    /// A curve to plot (x label, y label, points) from the output directory, if any.
+    pub curve: Option<fn(&Path) -> Result<(String, String, Vec<(f64, f64)>), String>>,
+}
+
+/// What running a case gave.
+pub struct Outcome {
+    pub name: String,
+    pub quantity: String,
+    pub unit: &'static str,
+    pub kind: Kind,
+    pub measured: f64,
+    pub reference: f64,
+    pub formula: String,
+    pub error_percent: f64,
+    pub tolerance_percent: f64,
+    pub particles: usize,
+    pub force_evaluations: u64,
+    pub seconds: f64,
+    pub passed: bool,
+    pub plot: Option<PathBuf>,
+}
+
+/// The columns of `history.csv` by name, and its rows.
+pub fn read_history(dir: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
+    let path = dir.join("history.csv");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .ok_or_else(|| format!("{}: empty", path.display()))?
+        .split(',')
+        .map(String::from)
+        .collect();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| {
+                    v.parse::<f64>()
+                        .map_err(|e| format!("{}: {e}", path.display()))
+                })
+                .collect::<Result<Vec<f64>, String>>()
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok((header, rows))
+}
+
+/// The last value of a history column.
+pub fn last_of(dir: &Path, column: &str) -> Result<f64, String> {
+    let (header, rows) = read_history(dir)?;
+    let c = header
+        .iter()
+        .position(|h| h == column)
+        .ok_or_else(|| format!("history.csv has no column '{column}'"))?;
+    rows.last()
+        .map(|r| r[c])
+        .ok_or_else(|| "history.csv has no rows".to_string())
+}
+
+/// An elastic cantilever (square section h × h, length L from the clamp to the load) of
+/// `model`, clamped over three lattice planes at x = 0 and loaded at its free end by a total
+/// force P downward on the last two planes, relaxed to equilibrium; the tip deflection of
+/// the centre of the end section against Timoshenko beam theory.
+fn cantilever(model: &str, level: Level) -> Case {
+    // Lattice cells across the (square) section, odd so that a particle sits on the axis; the
+    // span is 10 sections.
+    let (cells, m) = match level {
+        Level::Quick => (7usize, 3.0),
+        Level::Full => (13usize, 3.0),
+    };
+    let dx = 0.01;
+    // Sites sit at cell centres: a box [0, n dx] holds n planes.
+    let h = cells as f64 * dx;
+    let n_len = 10 * cells + 4;
+    let length_x = n_len as f64 * dx;
+    let (e, nu) = (10.0e9, 0.25);
+    let p: f64 = -1000.0;
+    // PMB has ν = 1/4 by construction.
+    let material = match model {
+        "pmb" => format!("youngs_modulus = \"{e} Pa\"\n"),
+        _ => format!("youngs_modulus = \"{e} Pa\"\npoisson_ratio = {nu}\n"),
+    };
+    let correction = if model == "lps" {
+        ""
+    } else {
+        "surface_correction = \"energy\"\n"
+    };
+    // Clamp: the three planes x < 3 dx, so the beam starts at x = 3 dx. Load: the last two
+    // planes, centred at x = L_x − dx.
+    let span = (length_x - dx) - 3.0 * dx;
+    let inertia = h.powi(4) / 12.0;
+    let area = h * h;
+    let g = e / (2.0 * (1.0 + nu));
+    let bending = p.abs() * span.powi(3) / (3.0 * e * inertia);
+    let shear = p.abs() * span / (5.0 / 6.0 * g * area);
+    let mid = h / 2.0;
+    let deck = format!(
+        r#"title = "validation: {model} cantilever, end load"
+units = "SI"
+[model]
+name = "{model}"
+m = {m}
+{correction}[lattice]
+spacing = "{dx} m"
+[materials.solid]
+density = "2400 kg/m^3"
+{material}critical_stretch = 1.0
+[[geometry]]
+shape = "box"
+material = "solid"
+min = "0 0 0 m"
+max = "{length_x} {h} {h} m"
+[time]
+duration = "1 s"
+[solver]
+kind = "adr"
+load_steps = 1
+tolerance = 1e-7
+max_iterations = 400000
+[[boundary]]
+name = "clamp"
+region = {{ shape = "slab", axis = "x", from = "0 m", to = "{clamp_to} m" }}
+fixed = ["all"]
+[[load]]
+name = "tip"
+region = {{ shape = "slab", axis = "x", from = "{load_from} m", to = "{length_x} m" }}
+total_force = "0 0 {p} N"
+[[probe]]
+name = "tip"
+at = "{tip_x} {mid} {mid} m"
+[output]
+progress = false
+history_every = 1
+"#,
+        clamp_to = 3.0 * dx,
+        load_from = length_x - 2.0 * dx,
+        tip_x = length_x - 0.5 * dx,
+    );
+    Case {
+        name: format!("cantilever_{model}"),
+        quantity: "tip deflection".into(),
+        unit: "m",
+        kind: Kind::Elastic,
+        reference: bending + shear,
+        formula: format!(
+            "Timoshenko PL³/3EI + PL/κGA, κ = 5/6; L = {span:.3} m, h = {h:.3} m, E = {:.0} GPa, ν = {nu}",
+            e / 1e9
+        ),
+        tolerance_percent: 2.0,
+        deck,
+        extract: |_, dir| Ok(-last_of(dir, "tip_uz")?),
+        curve: None,
+    }
+}
+
+/// The cases of a level, in report order.
+pub fn cases(level: Level) -> Vec<Case> {
+    ["pmb", "lps", "micropolar"]
+        .iter()
+        .map(|m| cantilever(m, level))
+        .collect()
+}
+
+/// Runs `case` with its output in `dir`.
+pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, String> {
+    let scene = deck::parse(&case.deck, &format!("{}.toml", case.name), &case.name)
+        .map_err(|e| format!("case {}: {e}", case.name))?;
+    let start = Instant::now();
+    let summary = run::run(
+        &scene,
+        &RunOptions {
+            output: Some(dir.to_path_buf()),
+            quiet: true,
+            threads: Some(threads),
+            ..Default::default()
+        },
+    )
+    .map_err(|e| format!("case {}: {e}", case.name))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let measured = (case.extract)(&summary, dir)?;
+    let error_percent = 100.0 * (measured - case.reference) / case.reference;
+    let passed = measured.is_finite()
+        && (case.kind == Kind::Strength || error_percent.abs() <= case.tolerance_percent);
+    Ok(Outcome {
+        name: case.name.clone(),
+        quantity: case.quantity.clone(),
+        unit: case.unit,
+        kind: case.kind,
+        measured,
+        reference: case.reference,
+        formula: case.formula.clone(),
+        error_percent,
+        tolerance_percent: case.tolerance_percent,
+        particles: summary.particles,
+        force_evaluations: summary.force_evaluations,
+        seconds,
+        passed,
+        plot: None,
+    })
+}
+
+/// The table `pdq validate` prints and writes into `report.md`.
+pub fn table(outcomes: &[Outcome]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "| case | quantity | PDQ | reference | error % | tolerance % | result | particles | force evaluations | run time s |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+    for o in outcomes {
+        let result = match (o.kind, o.passed) {
+            (Kind::Strength, _) => "reported",
+            (Kind::Elastic, true) => "pass",
+            (Kind::Elastic, false) => "FAIL",
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} ({}) | {:.5e} | {:.5e} | {:+.2} | {} | {} | {} | {} | {:.1} |",
+            o.name,
+            o.quantity,
+            o.unit,
+            o.measured,
+            o.reference,
+            o.error_percent,
+            o.tolerance_percent,
+            result,
+            o.particles,
+            o.force_evaluations,
+            o.seconds
+        );
+    }
+    s
+}
+
+/// Options of `pdq validate`.
+#[derive(Clone, Debug)]
+pub struct ValidateOptions {
+    pub level: Level,
+    /// Case names to run (all when empty).
+    pub only: Vec<String>,
+    pub output: PathBuf,
+    pub threads: usize,
+}
+
+/// Runs the cases, writes `report.md` into the output directory and returns the table and
+/// whether every elastic case met its tolerance.
+pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
+    let all = cases(opts.level);
+    for name in &opts.only {
+        if !all.iter().any(|c| &c.name == name) {
+            let names: Vec<&str> = all.iter().map(|c| c.name.as_str()).collect();
+            return Err(format!(
+                "no validation case '{name}' (cases: {})",
+                names.join(", ")
+            ));
+        }
+    }
+    std::fs::create_dir_all(&opts.output).map_err(|e| format!("{}: {e}", opts.output.display()))?;
+    let mut outcomes = Vec::new();
+    for case in all
+        .iter()
+        .filter(|c| opts.only.is_empty() || opts.only.contains(&c.name))
+    {
+        let dir = opts.output.join(&case.name);
+        eprintln!("case       {} ...", case.name);
+        let o = run_case(case, &dir, opts.threads)?;
+        eprintln!(
+            "           {} = {:.5e} {} against {:.5e} ({:+.2} %) in {:.1} s",
+            o.quantity, o.measured, o.unit, o.reference, o.error_percent, o.seconds
+        );
+        outcomes.push(o);
+    }
+    let t = table(&outcomes);
+    let mut report = String::new();
+    let _ = writeln!(
+        report,
+        "# PDQ validation ({})\n",
+        match opts.level {
+            Level::Quick => "--quick",
+            Level::Full => "--full",
+        }
+    );
+    report.push_str(&t);
+    report.push_str("\nReferences:\n\n");
+    for o in &outcomes {
+        let _ = writeln!(report, "- `{}`: {}", o.name, o.formula);
+    }
+    let path = opts.output.join("report.md");
+    std::fs::write(&path, &report).map_err(|e| format!("{}: {e}", path.display()))?;
+    let ok = outcomes.iter().all(|o| o.passed);
+    Ok((t, ok))
+}
