@@ -25,6 +25,7 @@ pub mod models;
 pub mod output;
 pub mod parallel;
 pub mod particles;
+pub mod plot;
 pub mod relaxation;
 pub mod run;
 pub mod setup;

@@ -27,6 +27,14 @@ pub enum Kind {
     Strength,
 }
 
+/// A plot of a case: the measured curve (read from the run's output) against the reference.
+pub struct Plot {
+    pub x_label: String,
+    pub y_label: String,
+    pub reference: Vec<(f64, f64)>,
+    pub measured: fn(&Path) -> Result<Vec<(f64, f64)>, String>,
+}
+
 /// One validation case.
 pub struct Case {
     pub name: String,
@@ -40,8 +48,7 @@ pub struct Case {
     pub deck: String,
     /// The measured value from the run's summary and output directory.
     pub extract: fn(&Summary, &Path) -> Result<f64, String>,
-    /// A curve to plot (x label, y label, points) from the output directory, if any.
-    pub curve: Option<fn(&Path) -> Result<(String, String, Vec<(f64, f64)>), String>>,
+    pub plot: Option<Plot>,
 }
 
 /// What running a case gave.
@@ -114,7 +121,8 @@ fn cantilever(model: &str, level: Level) -> Case {
     let h = cells as f64 * dx;
     let n_len = 10 * cells + 4;
     let length_x = n_len as f64 * dx;
-    let (e, nu) = (10.0e9, 0.25);
+    // Micropolar at ν = 0.2, where its shear bonds act (at ν = 1/4 it is PMB).
+    let (e, nu) = (10.0e9, if model == "micropolar" { 0.2 } else { 0.25 });
     let p: f64 = -1000.0;
     // PMB has ν = 1/4 by construction.
     let material = match model {
@@ -172,6 +180,7 @@ at = "{tip_x} {mid} {mid} m"
 [output]
 progress = false
 history_every = 1
+frames_every = 1
 "#,
         clamp_to = 3.0 * dx,
         load_from = length_x - 2.0 * dx,
@@ -190,8 +199,63 @@ history_every = 1
         tolerance_percent: 2.0,
         deck,
         extract: |_, dir| Ok(-last_of(dir, "tip_uz")?),
-        curve: None,
+        plot: Some(Plot {
+            x_label: "x (m)".into(),
+            y_label: "deflection of the beam axis (m)".into(),
+            // w(ξ) = Pξ²(3L − ξ)/6EI + Pξ/κGA from the clamp face at x = 3 dx.
+            reference: (0..=50)
+                .map(|k| {
+                    let xi = span * k as f64 / 50.0;
+                    let w = p * xi * xi * (3.0 * span - xi) / (6.0 * e * inertia)
+                        + p * xi / (5.0 / 6.0 * g * area);
+                    (3.0 * dx + xi, w)
+                })
+                .collect(),
+            measured: |dir| axis_deflection(dir),
+        }),
     }
+}
+
+/// (x₀, u_z) of the particles on the beam's axis in the last frame (those nearest the line
+/// through the section's centre along x).
+fn axis_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
+    let frames = dir.join("frames");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&frames)
+        .map_err(|e| format!("{}: {e}", frames.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "h5"))
+        .collect();
+    files.sort();
+    let last = files.last().ok_or("no frames")?;
+    let f = hdf5_pure::File::open(last).map_err(|e| format!("{}: {e}", last.display()))?;
+    let read = |name: &str| {
+        f.dataset(name)
+            .and_then(|d| d.read_f64())
+            .map_err(|e| format!("{}: {name}: {e}", last.display()))
+    };
+    let (points, u) = (read("points")?, read("displacement")?);
+    let x0: Vec<[f64; 3]> = points
+        .chunks_exact(3)
+        .zip(u.chunks_exact(3))
+        .map(|(p, u)| [p[0] - u[0], p[1] - u[1], p[2] - u[2]])
+        .collect();
+    let centre = |k: usize| {
+        let (lo, hi) = x0
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x[k]), b.max(x[k])));
+        0.5 * (lo + hi)
+    };
+    let (yc, zc) = (centre(1), centre(2));
+    let off = |x: &[f64; 3]| (x[1] - yc).hypot(x[2] - zc);
+    let nearest = x0.iter().map(off).fold(f64::MAX, f64::min);
+    let mut line: Vec<(f64, f64)> = x0
+        .iter()
+        .zip(u.chunks_exact(3))
+        .filter(|(x, _)| off(x) <= nearest + 1e-9)
+        .map(|(x, u)| (x[0], u[2]))
+        .collect();
+    line.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(line)
 }
 
 /// The cases of a level, in report order.
@@ -222,6 +286,35 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
     let error_percent = 100.0 * (measured - case.reference) / case.reference;
     let passed = measured.is_finite()
         && (case.kind == Kind::Strength || error_percent.abs() <= case.tolerance_percent);
+    let plot = match &case.plot {
+        Some(pl) => {
+            let measured_curve = (pl.measured)(dir)?;
+            let path = dir.with_extension("png");
+            crate::plot::xy(
+                &path,
+                &format!(
+                    "{}: PDQ {:.4e}, reference {:.4e} ({:+.2} %)",
+                    case.name, measured, case.reference, error_percent
+                ),
+                &pl.x_label,
+                &pl.y_label,
+                &[
+                    crate::plot::Series {
+                        name: "PDQ",
+                        points: &measured_curve,
+                        mark: crate::plot::Mark::Points,
+                    },
+                    crate::plot::Series {
+                        name: "reference",
+                        points: &pl.reference,
+                        mark: crate::plot::Mark::Line,
+                    },
+                ],
+            )?;
+            Some(path)
+        }
+        None => None,
+    };
     Ok(Outcome {
         name: case.name.clone(),
         quantity: case.quantity.clone(),
@@ -236,7 +329,7 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
         force_evaluations: summary.force_evaluations,
         seconds,
         passed,
-        plot: None,
+        plot,
     })
 }
 
@@ -325,6 +418,12 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
     report.push_str("\nReferences:\n\n");
     for o in &outcomes {
         let _ = writeln!(report, "- `{}`: {}", o.name, o.formula);
+    }
+    for o in &outcomes {
+        if let Some(p) = &o.plot {
+            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            let _ = writeln!(report, "\n![{}]({name})", o.name);
+        }
     }
     let path = opts.output.join("report.md");
     std::fs::write(&path, &report).map_err(|e| format!("{}: {e}", path.display()))?;
