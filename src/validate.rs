@@ -27,12 +27,15 @@ pub enum Kind {
     Strength,
 }
 
+/// Reads a curve, as (x, y) points, from a run's output directory.
+pub type CurveReader = fn(&Path) -> Result<Vec<(f64, f64)>, String>;
+
 /// A plot of a case: the measured curve (read from the run's output) against the reference.
 pub struct Plot {
     pub x_label: String,
     pub y_label: String,
     pub reference: Vec<(f64, f64)>,
-    pub measured: fn(&Path) -> Result<Vec<(f64, f64)>, String>,
+    pub measured: CurveReader,
 }
 
 /// One validation case.
