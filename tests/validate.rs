@@ -1,0 +1,108 @@
+//! The validation runner: unknown cases are named, a measured value off its reference is
+//! reported as a failure with its error, and the report and plot files are written.
+
+use pdq::validate::{self, Case, Kind, Level, ValidateOptions};
+use std::path::Path;
+
+fn out(name: &str) -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("pdq-validate-{name}-{}", std::process::id()))
+}
+
+#[test]
+fn an_unknown_case_is_refused_with_the_list() {
+    let e = validate::run_all(&ValidateOptions {
+        level: Level::Quick,
+        only: vec!["cantilever_steel".into()],
+        output: out("unknown"),
+        threads: 1,
+    })
+    .expect_err("no such case");
+    assert!(
+        e.contains("cantilever_steel") && e.contains("cantilever_lps"),
+        "{e}"
+    );
+}
+
+/// A small relaxed bar whose tip displacement is compared with a reference that is wrong by
+/// a factor 2: the runner must report −50 % and a failure.
+#[test]
+fn a_case_off_its_reference_fails_with_its_error() {
+    let deck = r#"units = "SI"
+[model]
+name = "lps"
+m = 3
+[lattice]
+spacing = "1 mm"
+[materials.s]
+density = "2200 kg/m^3"
+youngs_modulus = "10 GPa"
+poisson_ratio = 0.25
+[[geometry]]
+shape = "box"
+material = "s"
+min = "0 0 0 mm"
+max = "20 5 5 mm"
+[time]
+duration = "1 s"
+[solver]
+kind = "adr"
+load_steps = 1
+tolerance = 1e-8
+[[boundary]]
+name = "left"
+region = { shape = "slab", axis = "x", from = "0 mm", to = "3 mm" }
+fixed = ["all"]
+[[load]]
+name = "pull"
+region = { shape = "slab", axis = "x", from = "18 mm", to = "20 mm" }
+total_force = "10 0 0 N"
+[[probe]]
+name = "tip"
+at = "19.5 2.5 2.5 mm"
+[output]
+progress = false
+history_every = 1
+"#;
+    let dir = out("bar");
+    let measure = |dir: &Path| validate::last_of(dir, "tip_ux");
+    let first = validate::run_case(
+        &Case {
+            name: "bar".into(),
+            quantity: "tip displacement".into(),
+            unit: "m",
+            kind: Kind::Elastic,
+            reference: 1.0,
+            formula: "none".into(),
+            tolerance_percent: 2.0,
+            deck: deck.into(),
+            extract: |_, dir| validate::last_of(dir, "tip_ux"),
+            plot: None,
+        },
+        &dir,
+        1,
+    )
+    .unwrap();
+    let measured = measure(&dir).unwrap();
+    assert!(measured > 0.0 && first.measured == measured);
+    let case = Case {
+        name: "bar".into(),
+        quantity: "tip displacement".into(),
+        unit: "m",
+        kind: Kind::Elastic,
+        reference: 2.0 * measured,
+        formula: "twice the answer".into(),
+        tolerance_percent: 2.0,
+        deck: deck.into(),
+        extract: |_, dir| validate::last_of(dir, "tip_ux"),
+        plot: None,
+    };
+    let o = validate::run_case(&case, &dir, 1).unwrap();
+    assert!(!o.passed);
+    assert!((o.error_percent + 50.0).abs() < 1e-9, "{}", o.error_percent);
+    let table = validate::table(&[o]);
+    assert!(
+        table.contains("FAIL") && table.contains("-50.00"),
+        "{table}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
