@@ -153,6 +153,24 @@ fn pdq() -> Command {
     Command::new(env!("CARGO_BIN_EXE_pdq"))
 }
 
+/// `pdq run DECK --quiet --output OUT` with `extra` arguments.
+fn pdq_run(deck: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut c = pdq();
+    c.arg("run")
+        .arg(deck)
+        .arg("--quiet")
+        .arg("--output")
+        .arg(out)
+        .args(extra);
+    c
+}
+
+/// Runs `pdq run` to the end and checks that it succeeded.
+fn pdq_run_ok(deck: &Path, out: &Path, extra: &[&str]) {
+    let status = pdq_run(deck, out, extra).status().unwrap();
+    assert!(status.success(), "pdq run {extra:?} failed");
+}
+
 /// Writes `text` as a deck file in `dir` and returns its path.
 fn deck_file(dir: &Path, text: &str) -> PathBuf {
     std::fs::create_dir_all(dir).unwrap();
@@ -176,22 +194,10 @@ fn a_run_killed_while_writing_a_checkpoint_resumes_from_the_previous_one() {
     let deck = deck_file(&work, &text);
     let out = work.join("out");
     // Checkpoints at 100 and 200.
-    let ok = pdq()
-        .arg("run")
-        .arg(&deck)
-        .args(["--quiet", "--steps", "200", "--output"])
-        .arg(&out)
-        .status()
-        .unwrap();
-    assert!(ok.success());
+    pdq_run_ok(&deck, &out, &["--steps", "200"]);
     // Resume, and kill the run halfway through writing the checkpoint of step 300.
-    let mut child = pdq()
-        .arg("run")
-        .arg(&deck)
-        .args(["--quiet", "--output"])
-        .arg(&out)
-        .arg("--restart")
-        .arg(&out)
+    let from = out.to_str().unwrap().to_string();
+    let mut child = pdq_run(&deck, &out, &["--restart", &from])
         .env("PDQ_CHECKPOINT_PAUSE_MS", "30000")
         .spawn()
         .unwrap();
@@ -213,25 +219,9 @@ fn a_run_killed_while_writing_a_checkpoint_resumes_from_the_previous_one() {
     assert!(Checkpoint::read(&tmp).is_err());
     let (path, c) = pdq::checkpoint::resolve(&out).unwrap();
     assert_eq!(c.step, 200, "resumes from {}", path.display());
-    let resumed = pdq()
-        .arg("run")
-        .arg(&deck)
-        .args(["--quiet", "--output"])
-        .arg(&out)
-        .arg("--restart")
-        .arg(&out)
-        .status()
-        .unwrap();
-    assert!(resumed.success());
+    pdq_run_ok(&deck, &out, &["--restart", &from]);
     let straight = work.join("straight");
-    let ok = pdq()
-        .arg("run")
-        .arg(&deck)
-        .args(["--quiet", "--output"])
-        .arg(&straight)
-        .status()
-        .unwrap();
-    assert!(ok.success());
+    pdq_run_ok(&deck, &straight, &[]);
     for file in ["final_positions.csv", "broken_bonds.csv", "history.csv"] {
         assert!(read(&straight, file) == read(&out, file), "{file} differs");
     }
@@ -245,18 +235,7 @@ fn sigterm_writes_a_checkpoint_and_the_run_resumes_from_it() {
     let text = pull_deck("pmb").replace("checkpoint_every = 250", "");
     let deck = deck_file(&work, &text);
     let out = work.join("out");
-    let child = pdq()
-        .arg("run")
-        .arg(&deck)
-        .args([
-            "--quiet",
-            "--threads",
-            "2",
-            "--steps",
-            "100000000",
-            "--output",
-        ])
-        .arg(&out)
+    let child = pdq_run(&deck, &out, &["--threads", "2", "--steps", "100000000"])
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
@@ -291,25 +270,14 @@ fn sigterm_writes_a_checkpoint_and_the_run_resumes_from_it() {
     );
     // Resuming to a few steps further matches a run that went there straight.
     let end = (c.step + 50).to_string();
-    let resumed = pdq()
-        .arg("run")
-        .arg(&deck)
-        .args(["--quiet", "--threads", "2", "--steps", &end, "--output"])
-        .arg(&out)
-        .arg("--restart")
-        .arg(&out)
-        .status()
-        .unwrap();
-    assert!(resumed.success());
+    let from = out.to_str().unwrap().to_string();
+    pdq_run_ok(
+        &deck,
+        &out,
+        &["--threads", "2", "--steps", &end, "--restart", &from],
+    );
     let straight = work.join("straight");
-    let ok = pdq()
-        .arg("run")
-        .arg(&deck)
-        .args(["--quiet", "--threads", "2", "--steps", &end, "--output"])
-        .arg(&straight)
-        .status()
-        .unwrap();
-    assert!(ok.success());
+    pdq_run_ok(&deck, &straight, &["--threads", "2", "--steps", &end]);
     for file in ["final_positions.csv", "broken_bonds.csv"] {
         assert!(read(&straight, file) == read(&out, file), "{file} differs");
     }

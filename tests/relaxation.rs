@@ -75,14 +75,8 @@ fn relax(model: &str, threads: usize, procs: [usize; 3]) -> (Summary, Vec<Vec<f6
         },
     )
     .unwrap();
-    let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|c| *c == name).unwrap();
-    let rows: Vec<Vec<f64>> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let (header, rows) = pdq::validate::read_history(&dir).unwrap();
+    let col = |name: &str| header.iter().position(|c| c == name).unwrap();
     let picked = rows
         .iter()
         .map(|r| {
