@@ -160,3 +160,36 @@ fn relaxation_refuses_a_temperature_model() {
     .expect_err("thermal cannot be relaxed");
     assert!(e.contains("bar.toml:") && e.contains("first-order"), "{e}");
 }
+
+#[test]
+fn a_relaxation_restarted_between_load_steps_ends_bit_identical() {
+    let text = bar_deck("pmb").replace(
+        "history_every = 1",
+        "history_every = 1\ncheckpoint_every = 2\nfinal_state = true",
+    );
+    let scene = deck::parse(&text, "bar.toml", "bar").unwrap();
+    let dir = |name: &str| {
+        std::env::temp_dir().join(format!("pdq-adr-restart-{name}-{}", std::process::id()))
+    };
+    let opts = |out: std::path::PathBuf,
+                steps: Option<u64>,
+                restart: Option<std::path::PathBuf>| RunOptions {
+        output: Some(out),
+        quiet: true,
+        steps,
+        restart,
+        ..Default::default()
+    };
+    let (straight, resumed) = (dir("straight"), dir("resumed"));
+    run(&scene, &opts(straight.clone(), None, None)).unwrap();
+    run(&scene, &opts(resumed.clone(), Some(2), None)).unwrap();
+    let r = run(&scene, &opts(resumed.clone(), None, Some(resumed.clone()))).unwrap();
+    assert_eq!((r.first_step, r.steps), (2, 4));
+    for file in ["final_positions.csv", "history.csv"] {
+        let a = std::fs::read_to_string(straight.join(file)).unwrap();
+        let b = std::fs::read_to_string(resumed.join(file)).unwrap();
+        assert!(a == b, "{file} differs after restarting between load steps");
+    }
+    let _ = std::fs::remove_dir_all(straight);
+    let _ = std::fs::remove_dir_all(resumed);
+}
