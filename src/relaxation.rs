@@ -160,22 +160,16 @@ impl<M: Model> Cube<M> {
                     sums[2] += force[idx] * force[idx];
                 }
             }
-            let mut applied: Vec<f64> = Vec::new();
-            for l in &self.sim.loads {
-                applied.extend_from_slice(&l.total(self.sim.time));
-            }
-            let first_reaction = applied.len();
-            for c in &self.sim.constraints {
-                applied.extend_from_slice(&c.reaction);
-            }
+            // Each procCube holds its share of every load's total and support's reaction:
+            // summed, they are the whole scene's.
             let mut all: Vec<f64> = sums.to_vec();
-            all.extend_from_slice(&applied);
-            let mut team = Team::new(self.sim.exchange.transport());
-            // Loads' totals are the same on every procCube: only rank 0 contributes them.
-            if team.rank() != 0 {
-                all[3..3 + first_reaction].fill(0.0);
+            for l in &self.sim.loads {
+                all.extend_from_slice(&l.total(self.sim.time));
             }
-            team.reduce(&mut all, Reduce::Sum);
+            for c in &self.sim.constraints {
+                all.extend_from_slice(&c.reaction);
+            }
+            Team::new(self.sim.exchange.transport()).reduce(&mut all, Reduce::Sum);
             let scale = all[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
             residual = all[2].sqrt() / scale.max(f64::MIN_POSITIVE);
             if residual <= tolerance || iterations >= max_iterations {
