@@ -103,6 +103,7 @@ fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
             c.push(format!("{name}_{k}"));
         }
     }
+    c.push("residual_force".into());
     if let SolverSpec::Relaxation { .. } = setup.solver {
         c.push("iterations".into());
         c.push("residual".into());
@@ -154,6 +155,15 @@ fn row<M: Model>(cube: &mut Cube<M>, damage: &[f64], n_probes: usize) -> Vec<f64
         sums[first_probe + 3 * k..first_probe + 3 * k + 3]
             .copy_from_slice(&sim.particles.displacement(i));
     }
+    // Σ F² over the free second-order DOFs (supported ones hold 0): how far from equilibrium.
+    let n2 = crate::model::second_order::<M>();
+    let p = &sim.particles;
+    sums.push(
+        (0..p.n_owned)
+            .flat_map(|i| p.force[i].as_slice()[..n2].iter())
+            .map(|f| f * f)
+            .sum(),
+    );
     let (step, time) = (sim.step as f64, sim.time);
     let mut team = Team::new(cube.sim.exchange.transport());
     team.reduce(&mut sums, Reduce::Sum);
@@ -167,7 +177,9 @@ fn row<M: Model>(cube: &mut Cube<M>, damage: &[f64], n_probes: usize) -> Vec<f64
         sums[2],
         max_damage,
     ];
+    let squared = sums.pop().unwrap_or(0.0);
     r.extend_from_slice(&sums[3..]);
+    r.push(squared.sqrt());
     r
 }
 
