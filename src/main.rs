@@ -60,6 +60,10 @@ enum Cmd {
         /// Threads per case.
         #[arg(long, default_value_t = 1)]
         threads: usize,
+        /// Instead of the cases: ADR against an explicit load ramp on the LPS cantilever
+        /// (force evaluations to the same residual).
+        #[arg(long)]
+        compare_adr: bool,
     },
     /// Print what a frame or checkpoint file holds: step, time, particles, attributes, bonds.
     Info { file: PathBuf },
@@ -151,6 +155,15 @@ fn main() -> ExitCode {
             cases,
             output,
             threads,
+            compare_adr: true,
+        } => pdq::validate::compare_adr(&output, threads).map(|s| print!("{s}")),
+        Cmd::Validate {
+            quick: _,
+            full,
+            cases,
+            output,
+            threads,
+            compare_adr: false,
         } => pdq::validate::run_all(&pdq::validate::ValidateOptions {
             level: if full {
                 pdq::validate::Level::Full

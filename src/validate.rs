@@ -556,3 +556,96 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
     let ok = outcomes.iter().all(|o| o.passed);
     Ok((t, ok))
 }
+
+/// ADR against an explicit load ramp on the quick LPS cantilever: the explicit run ramps the
+/// load over five periods of the beam's first bending mode and holds it for three; the
+/// smallest relative residual it reaches after the ramp is then asked of ADR, and the force
+/// evaluations of both are compared. Returns the lines to print.
+pub fn compare_adr(output: &Path, threads: usize) -> Result<String, String> {
+    let case = cantilever("lps", Level::Quick);
+    // First bending period: ω₁ = 1.875² √(EI / (ρ A L⁴)) with the case's section and span.
+    let (e, rho, h, span): (f64, f64, f64, f64) = (10.0e9, 2400.0, 0.07, 0.70);
+    let omega = 1.875f64.powi(2) * (e * h * h / 12.0 / rho).sqrt() / (span * span);
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let adr_block =
+        "[solver]\nkind = \"adr\"\nload_steps = 1\ntolerance = 1e-7\nmax_iterations = 400000\n";
+    if !case.deck.contains(adr_block) {
+        return Err("the cantilever deck changed: update compare_adr".into());
+    }
+    let explicit = case
+        .deck
+        .replace(adr_block, "")
+        .replace(
+            "duration = \"1 s\"",
+            &format!("duration = \"{} s\"", 8.0 * period),
+        )
+        .replace(
+            "total_force = \"0 0 -1000 N\"",
+            &format!(
+                "total_force = \"0 0 -1000 N\"\nhistory = {{ ramp = \"{} s\" }}",
+                5.0 * period
+            ),
+        )
+        .replace("history_every = 1\nframes_every = 1", "history_every = 20");
+    let dir = output.join("compare_explicit");
+    let scene = deck::parse(&explicit, "compare_explicit.toml", "compare")
+        .map_err(|e| format!("compare: {e}"))?;
+    let t = Instant::now();
+    let s = run::run(
+        &scene,
+        &RunOptions {
+            output: Some(dir.clone()),
+            quiet: true,
+            threads: Some(threads),
+            ..Default::default()
+        },
+    )?;
+    let explicit_seconds = t.elapsed().as_secs_f64();
+    let (header, rows) = read_history(&dir)?;
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| format!("history has no column '{name}'"))
+    };
+    let (time, load, force) = (col("time")?, col("load_tip")?, col("residual_force")?);
+    let reactions: Vec<usize> = ["x", "y", "z"]
+        .iter()
+        .map(|c| col(&format!("reaction_clamp_{c}")))
+        .collect::<Result<_, _>>()?;
+    let relative = |r: &[f64]| {
+        let scale = (r[load].powi(2) + reactions.iter().map(|&k| r[k].powi(2)).sum::<f64>()).sqrt();
+        r[force] / scale.max(f64::MIN_POSITIVE)
+    };
+    let (best_row, best) = rows
+        .iter()
+        .filter(|r| r[time] >= 5.0 * period)
+        .map(|r| (r, relative(r)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .ok_or("the explicit run has no rows after its ramp")?;
+    let explicit_evaluations = best_row[0] as u64;
+    let adr_deck = case
+        .deck
+        .replace("tolerance = 1e-7", &format!("tolerance = {best:e}"));
+    let adr_dir = output.join("compare_adr");
+    let scene = deck::parse(&adr_deck, "compare_adr.toml", "compare")
+        .map_err(|e| format!("compare: {e}"))?;
+    let t = Instant::now();
+    let a = run::run(
+        &scene,
+        &RunOptions {
+            output: Some(adr_dir),
+            quiet: true,
+            threads: Some(threads),
+            ..Default::default()
+        },
+    )?;
+    let adr_seconds = t.elapsed().as_secs_f64();
+    Ok(format!(
+        "explicit load ramp (5 periods of {:.2} ms, then held; {} steps in all, {explicit_seconds:.1} s): smallest relative residual after the ramp {best:.2e}, reached at step {explicit_evaluations}\nADR to the same residual: {} force evaluations ({adr_seconds:.1} s)\nratio explicit/ADR force evaluations: {:.1}\n",
+        1e3 * period,
+        s.steps,
+        a.force_evaluations,
+        explicit_evaluations as f64 / a.force_evaluations.max(1) as f64
+    ))
+}
