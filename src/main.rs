@@ -150,12 +150,10 @@ fn main() -> ExitCode {
                 }
             }),
         Cmd::Validate {
-            quick: _,
-            full,
-            cases,
             output,
             threads,
             compare_adr: true,
+            ..
         } => pdq::validate::compare_adr(&output, threads).map(|s| print!("{s}")),
         Cmd::Validate {
             quick: _,
