@@ -108,46 +108,63 @@ pub fn last_of(dir: &Path, column: &str) -> Result<f64, String> {
         .ok_or_else(|| "history.csv has no rows".to_string())
 }
 
-/// An elastic cantilever (square section h × h, length L from the clamp to the load) of
-/// `model`, clamped over three lattice planes at x = 0 and loaded at its free end by a total
-/// force P downward on the last two planes, relaxed to equilibrium; the tip deflection of
-/// the centre of the end section against Timoshenko beam theory.
-fn cantilever(model: &str, level: Level) -> Case {
-    // Lattice cells across the (square) section, odd so that a particle sits on the axis; the
-    // span is 10 sections.
-    let (cells, m) = match level {
-        Level::Quick => (7usize, 3.0),
-        Level::Full => (13usize, 3.0),
-    };
-    let dx = 0.01;
-    // Sites sit at cell centres: a box [0, n dx] holds n planes.
-    let h = cells as f64 * dx;
-    let n_len = 10 * cells + 4;
-    let length_x = n_len as f64 * dx;
-    // Micropolar at ν = 0.2, where its shear bonds act (at ν = 1/4 it is PMB).
-    let (e, nu) = (10.0e9, if model == "micropolar" { 0.2 } else { 0.25 });
-    let p: f64 = -1000.0;
-    // PMB has ν = 1/4 by construction.
-    let material = match model {
-        "pmb" => format!("youngs_modulus = \"{e} Pa\"\n"),
-        _ => format!("youngs_modulus = \"{e} Pa\"\npoisson_ratio = {nu}\n"),
-    };
-    let correction = if model == "lps" {
-        ""
-    } else {
-        "surface_correction = \"energy\"\n"
-    };
-    // Clamp: the three planes x < 3 dx, so the beam starts at x = 3 dx. Load: the last two
-    // planes, centred at x = L_x − dx.
-    let span = (length_x - dx) - 3.0 * dx;
-    let inertia = h.powi(4) / 12.0;
-    let area = h * h;
-    let g = e / (2.0 * (1.0 + nu));
-    let bending = p.abs() * span.powi(3) / (3.0 * e * inertia);
-    let shear = p.abs() * span / (5.0 / 6.0 * g * area);
-    let mid = h / 2.0;
-    let deck = format!(
-        r#"title = "validation: {model} cantilever, end load"
+/// A beam of the suite: square section of `cells` lattice planes (odd, so that a particle sits
+/// on the axis) at dx = 10 mm, E = 10 GPa, ν = 1/4 (PMB's own) or 0.2 for micropolar (where its
+/// shear bonds act: at ν = 1/4 it is PMB); bond-based models with the energy surface
+/// correction, LPS without (it has none); m = 3; relaxed by ADR to 10⁻⁷ in one load step.
+struct Beam {
+    model: String,
+    cells: usize,
+    m: f64,
+    dx: f64,
+    e: f64,
+    nu: f64,
+}
+
+impl Beam {
+    fn new(model: &str, level: Level) -> Beam {
+        let (cells, m) = match level {
+            Level::Quick => (7, 3.0),
+            Level::Full => (13, 3.0),
+        };
+        Beam {
+            model: model.to_string(),
+            cells,
+            m,
+            dx: 0.01,
+            e: 10.0e9,
+            nu: if model == "micropolar" { 0.2 } else { 0.25 },
+        }
+    }
+
+    /// Section depth: sites sit at cell centres, so a box [0, n dx] holds n planes.
+    fn h(&self) -> f64 {
+        self.cells as f64 * self.dx
+    }
+
+    fn inertia(&self) -> f64 {
+        self.h().powi(4) / 12.0
+    }
+
+    /// κGA with κ = 5/6.
+    fn shear_stiffness(&self) -> f64 {
+        5.0 / 6.0 * self.e / (2.0 * (1.0 + self.nu)) * self.h() * self.h()
+    }
+
+    /// The deck through `[solver]`: model, lattice, material and a box `length_x` long.
+    fn deck_head(&self, title: &str, length_x: f64) -> String {
+        let (model, m, dx, e, nu, h) = (&self.model, self.m, self.dx, self.e, self.nu, self.h());
+        let material = match model.as_str() {
+            "pmb" => format!("youngs_modulus = \"{e} Pa\"\n"),
+            _ => format!("youngs_modulus = \"{e} Pa\"\npoisson_ratio = {nu}\n"),
+        };
+        let correction = if model == "lps" {
+            ""
+        } else {
+            "surface_correction = \"energy\"\n"
+        };
+        format!(
+            r#"title = "validation: {model} {title}"
 units = "SI"
 [model]
 name = "{model}"
@@ -169,7 +186,41 @@ kind = "adr"
 load_steps = 1
 tolerance = 1e-7
 max_iterations = 400000
-[[boundary]]
+"#
+        )
+    }
+
+    /// The material in words, for the report.
+    fn describe(&self) -> String {
+        format!(
+            "h = {:.3} m, E = {:.0} GPa, ν = {}",
+            self.h(),
+            self.e / 1e9,
+            self.nu
+        )
+    }
+}
+
+/// The output section of the beam decks: a history row and a frame per load step.
+const BEAM_OUTPUT: &str = "[output]\nprogress = false\nhistory_every = 1\nframes_every = 1\n";
+
+/// An elastic cantilever of `model` (span 10 sections), clamped over three lattice planes at
+/// x = 0 and loaded at its free end by a total force P downward on the last two planes; the
+/// tip deflection of the centre of the end section against Timoshenko beam theory.
+fn cantilever(model: &str, level: Level) -> Case {
+    let beam = Beam::new(model, level);
+    let (dx, e, h) = (beam.dx, beam.e, beam.h());
+    let length_x = (10 * beam.cells + 4) as f64 * dx;
+    let p: f64 = -1000.0;
+    // Clamp: the three planes x < 3 dx, so the beam starts at x = 3 dx. Load: the last two
+    // planes, centred at x = L_x − dx.
+    let span = (length_x - dx) - 3.0 * dx;
+    let (inertia, shear_stiffness) = (beam.inertia(), beam.shear_stiffness());
+    let bending = p.abs() * span.powi(3) / (3.0 * e * inertia);
+    let shear = p.abs() * span / shear_stiffness;
+    let mid = h / 2.0;
+    let deck = format!(
+        r#"{head}[[boundary]]
 name = "clamp"
 region = {{ shape = "slab", axis = "x", from = "0 m", to = "{clamp_to} m" }}
 fixed = ["all"]
@@ -180,11 +231,8 @@ total_force = "0 0 {p} N"
 [[probe]]
 name = "tip"
 at = "{tip_x} {mid} {mid} m"
-[output]
-progress = false
-history_every = 1
-frames_every = 1
-"#,
+{BEAM_OUTPUT}"#,
+        head = beam.deck_head("cantilever, end load", length_x),
         clamp_to = 3.0 * dx,
         load_from = length_x - 2.0 * dx,
         tip_x = length_x - 0.5 * dx,
@@ -196,8 +244,8 @@ frames_every = 1
         kind: Kind::Elastic,
         reference: bending + shear,
         formula: format!(
-            "Timoshenko PL³/3EI + PL/κGA, κ = 5/6; L = {span:.3} m, h = {h:.3} m, E = {:.0} GPa, ν = {nu}",
-            e / 1e9
+            "Timoshenko PL³/3EI + PL/κGA, κ = 5/6; L = {span:.3} m, {}",
+            beam.describe()
         ),
         tolerance_percent: 2.0,
         deck,
@@ -210,7 +258,7 @@ frames_every = 1
                 .map(|k| {
                     let xi = span * k as f64 / 50.0;
                     let w = p * xi * xi * (3.0 * span - xi) / (6.0 * e * inertia)
-                        + p * xi / (5.0 / 6.0 * g * area);
+                        + p * xi / shear_stiffness;
                     (3.0 * dx + xi, w)
                 })
                 .collect(),
@@ -219,63 +267,24 @@ frames_every = 1
     }
 }
 
-/// A simply supported beam (square section of `cells` planes, span 20 sections between the
-/// support lines) of `model` under a uniform load on its top layer, relaxed to equilibrium;
-/// the midspan deflection of the beam's axis relative to the axis above the supports (which
-/// removes the local indentation of the line supports, which beam theory does not have)
-/// against 5wL⁴/384EI + wL²/8κGA.
+/// A simply supported beam of `model` (span 20 sections between the support lines) under a
+/// uniform load on its top layer; the midspan deflection of the beam's axis relative to the
+/// axis above the supports (which removes the local indentation of the line supports, which
+/// beam theory does not have) against 5wL⁴/384EI + wL²/8κGA.
 fn simply_supported(model: &str, level: Level) -> Case {
-    let (cells, m) = match level {
-        Level::Quick => (7usize, 3.0),
-        Level::Full => (13usize, 3.0),
-    };
-    let dx = 0.01;
-    let h = cells as f64 * dx;
+    let beam = Beam::new(model, level);
+    let (dx, e, h) = (beam.dx, beam.e, beam.h());
     // An odd number of planes puts one at midspan; supports under the end planes.
-    let n_len = 20 * cells + 1;
-    let length_x = n_len as f64 * dx;
+    let length_x = (20 * beam.cells + 1) as f64 * dx;
     let span = length_x - dx;
-    let (e, nu) = (10.0e9, 0.25);
     let total: f64 = 20_000.0;
     let w = total / length_x;
-    let material = match model {
-        "pmb" => format!("youngs_modulus = \"{e} Pa\"\n"),
-        _ => format!("youngs_modulus = \"{e} Pa\"\npoisson_ratio = {nu}\n"),
-    };
-    let correction = if model == "lps" {
-        ""
-    } else {
-        "surface_correction = \"energy\"\n"
-    };
-    let inertia = h.powi(4) / 12.0;
-    let g = e / (2.0 * (1.0 + nu));
+    let (inertia, shear_stiffness) = (beam.inertia(), beam.shear_stiffness());
     let bending = 5.0 * w * span.powi(4) / (384.0 * e * inertia);
-    let shear = w * span * span / (8.0 * 5.0 / 6.0 * g * h * h);
+    let shear = w * span * span / (8.0 * shear_stiffness);
     let mid = h / 2.0;
     let deck = format!(
-        r#"title = "validation: {model} simply supported beam, uniform load"
-units = "SI"
-[model]
-name = "{model}"
-m = {m}
-{correction}[lattice]
-spacing = "{dx} m"
-[materials.solid]
-density = "2400 kg/m^3"
-{material}critical_stretch = 1.0
-[[geometry]]
-shape = "box"
-material = "solid"
-min = "0 0 0 m"
-max = "{length_x} {h} {h} m"
-[time]
-duration = "1 s"
-[solver]
-kind = "adr"
-load_steps = 1
-tolerance = 1e-7
-max_iterations = 400000
-[[boundary]]
+        r#"{head}[[boundary]]
 name = "pin"
 region = {{ shape = "box", min = "0 0 0 m", max = "{dx} {h} {dx} m" }}
 fixed = ["x", "y", "z"]
@@ -296,11 +305,8 @@ at = "{left_x} {mid} {mid} m"
 [[probe]]
 name = "right"
 at = "{right_x} {mid} {mid} m"
-[output]
-progress = false
-history_every = 1
-frames_every = 1
-"#,
+{BEAM_OUTPUT}"#,
+        head = beam.deck_head("simply supported beam, uniform load", length_x),
         roller_x = length_x - dx,
         top_z = h - dx,
         mid_x = length_x / 2.0,
@@ -314,8 +320,8 @@ frames_every = 1
         kind: Kind::Elastic,
         reference: bending + shear,
         formula: format!(
-            "5wL⁴/384EI + wL²/8κGA, κ = 5/6; L = {span:.3} m between the support lines, w = {w:.1} N/m, h = {h:.3} m, E = {:.0} GPa, ν = {nu}",
-            e / 1e9
+            "5wL⁴/384EI + wL²/8κGA, κ = 5/6; L = {span:.3} m between the support lines, w = {w:.1} N/m, {}",
+            beam.describe()
         ),
         tolerance_percent: 2.0,
         deck,
@@ -333,7 +339,7 @@ frames_every = 1
                     let x = span * k as f64 / 60.0;
                     let v = w * x * (span.powi(3) - 2.0 * span * x * x + x.powi(3))
                         / (24.0 * e * inertia)
-                        + w * x * (span - x) / (2.0 * 5.0 / 6.0 * g * h * h);
+                        + w * x * (span - x) / (2.0 * shear_stiffness);
                     (dx / 2.0 + x, -v)
                 })
                 .collect(),
