@@ -183,6 +183,98 @@ fn row<M: Model>(cube: &mut Cube<M>, damage: &[f64], n_probes: usize) -> Vec<f64
     r
 }
 
+/// The smallest global id of a particle that blew up, on every worker (a reduction: all must
+/// call it): coordinates or velocities not finite, or (explicit runs) a speed that carries it
+/// more than half a lattice spacing per step, which a stable run of a solid never reaches
+/// (about half the wave speed).
+fn first_blown_up<M: Model>(cube: &mut Cube<M>, limit: Option<f64>) -> Option<u32> {
+    let p = &cube.sim.particles;
+    let n2 = crate::model::second_order::<M>();
+    let dt = cube.sim.dt;
+    let runaway = |a: &[f64]| match limit {
+        Some(half_spacing) => {
+            let v2 = a[n2] * a[n2] + a[n2 + 1] * a[n2 + 1] + a[n2 + 2] * a[n2 + 2];
+            v2 * dt * dt > half_spacing * half_spacing
+        }
+        None => false,
+    };
+    let mine = (0..p.n_owned)
+        .filter(|&i| {
+            let a = p.alter[i].as_slice();
+            a.iter().any(|v| !v.is_finite()) || runaway(a)
+        })
+        .map(|i| p.gid[i] as f64)
+        .fold(f64::INFINITY, f64::min);
+    let mut v = [mine];
+    Team::new(cube.sim.exchange.transport()).reduce(&mut v, Reduce::Min);
+    v[0].is_finite().then_some(v[0] as u32)
+}
+
+/// Stops a run that blew up: writes a frame and a checkpoint of the state for inspection (all
+/// workers take part) and returns the message naming the step, the particle and the likely
+/// cause.
+fn blow_up<M: Model>(
+    cube: &mut Cube<M>,
+    plan: &Plan,
+    mut store: Option<FrameStore<M>>,
+    frames: Option<Frames>,
+    gid: u32,
+    step: u64,
+) -> String {
+    let damage = cube.damage();
+    gather_frame(cube, &damage, &mut store);
+    let ck = &plan.checkpoints;
+    let checkpoint = Checkpoint::gather(cube, ck.scene_hash, &ck.deck)
+        .map(|c| c.write(&ck.dir, ck.keep.max(1) + 1));
+    let Some(store) = store else {
+        return "another worker stopped the run: it blew up".into();
+    };
+    let mut files = Vec::new();
+    let frames = match frames {
+        Some(f) => Ok(f),
+        None => Frames::new(&plan.dir),
+    };
+    if let Ok(path) =
+        frames.and_then(|mut f| f.write(step, cube.sim.time, &store.particles, &store.damage, 0))
+    {
+        files.push(path.display().to_string());
+    }
+    if let Some(Ok((path, _))) = checkpoint {
+        files.push(path.display().to_string());
+    }
+    let i = store.index_of[gid as usize] as usize;
+    let p = &store.particles;
+    let material = plan
+        .material_names
+        .get(p.material[i] as usize)
+        .map_or("?", |s| s.as_str());
+    let ratio = cube.sim.dt / plan.dt_critical;
+    let cause = if plan.relaxation.is_some() {
+        "relaxation diverged: check the loads, supports and materials".to_string()
+    } else if ratio > 1.0 {
+        format!(
+            "the time step is {ratio:.2} × the stable bound ({:.4e} against {:.4e}): lower dt or drop force_dt",
+            cube.sim.dt, plan.dt_critical
+        )
+    } else {
+        format!(
+            "the time step is within the stable bound ({ratio:.2} × {:.4e}): check the material's stiffness and density, and the loads and prescribed velocities",
+            plan.dt_critical
+        )
+    };
+    format!(
+        "the run blew up at step {step}: particle {gid} (material '{material}', reference position [{:.6e}, {:.6e}, {:.6e}]) has a position or velocity that is not finite, or moves more than half a lattice spacing per step. Likely cause: {cause}. For inspection: {}",
+        p.x0[i][0],
+        p.x0[i][1],
+        p.x0[i][2],
+        if files.is_empty() {
+            "no file could be written".to_string()
+        } else {
+            files.join(", ")
+        }
+    )
+}
+
 /// True on every worker if any worker failed (so that all stop together, none left waiting).
 fn any_failed<M: Model>(cube: &mut Cube<M>, failed: bool) -> bool {
     Team::new(cube.sim.exchange.transport()).max(if failed { 1.0 } else { 0.0 }) > 0.0
@@ -261,6 +353,10 @@ struct Plan {
     first_step: u64,
     /// Relaxation: fictitious masses by global id, tolerance, iteration limit.
     relaxation: Option<(Vec<f64>, f64, u64)>,
+    /// For the blow-up diagnosis: the stable time step and the material names.
+    dt_critical: f64,
+    material_names: Vec<String>,
+    spacing: f64,
     checkpoints: CheckpointPlan,
 }
 
@@ -377,6 +473,10 @@ fn drive<M: Model>(
             let t = Instant::now();
             if any_failed(&mut cube, error.is_some()) {
                 return Err(error.unwrap_or_else(|| "another worker failed".into()));
+            }
+            let limit = plan.relaxation.is_none().then_some(0.5 * plan.spacing);
+            if let Some(gid) = first_blown_up(&mut cube, limit) {
+                return Err(blow_up(&mut cube, plan, store, frames, gid, step));
             }
             let damage = cube.damage();
             if want_row {
@@ -716,6 +816,9 @@ fn run_setup<M: Model>(
         layout: layout.describe(),
         first_step: resume.map_or(0, |c| c.step),
         relaxation: relaxation.clone(),
+        dt_critical: setup.dt_critical,
+        material_names: scene.materials.iter().map(|m| m.name.clone()).collect(),
+        spacing: scene.spacing,
         checkpoints: CheckpointPlan {
             dir: dir.join("checkpoints"),
             every: scene.output.checkpoint_every,
