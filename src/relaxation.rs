@@ -114,7 +114,11 @@ impl<M: Model> Cube<M> {
 
         let mut iterations = 1;
         self.sim.compute_forces();
-        let mut previous: Vec<f64> = self.owned_forces(n2);
+        // Forces of this and of the previous iteration, two buffers swapped: no allocation per
+        // iteration.
+        let mut previous: Vec<f64> = Vec::with_capacity(n * n2);
+        self.owned_forces(n2, &mut previous);
+        let mut force: Vec<f64> = Vec::with_capacity(n * n2);
         // u̇^½ = F⁰ / (2λ) (pseudo time step 1).
         {
             let p = &mut self.sim.particles;
@@ -138,7 +142,7 @@ impl<M: Model> Cube<M> {
             self.sim.compute_forces();
             iterations += 1;
             let t = Instant::now();
-            let force = self.owned_forces(n2);
+            self.owned_forces(n2, &mut force);
             // uᵀ¹Ku, uᵀu, |F|², and the scale: applied loads and support reactions.
             let p = &self.sim.particles;
             let mut sums = [0.0f64; 3];
@@ -191,7 +195,7 @@ impl<M: Model> Cube<M> {
                         ((2.0 - c) * a[n2 + k] + 2.0 * force[idx] / lambda[idx]) / (2.0 + c);
                 }
             }
-            previous = force;
+            std::mem::swap(&mut previous, &mut force);
             self.sim.timing.lap(Phase::Integration, t);
         }
         zero_velocities(&mut self.sim.particles);
@@ -203,11 +207,12 @@ impl<M: Model> Cube<M> {
     }
 
     /// Forces on the second-order DOFs of owned particles (zero on supported DOFs).
-    fn owned_forces(&self, n2: usize) -> Vec<f64> {
+    fn owned_forces(&self, n2: usize, out: &mut Vec<f64>) {
         let p = &self.sim.particles;
-        (0..p.n_owned)
-            .flat_map(|i| p.force[i].as_slice()[..n2].to_vec())
-            .collect()
+        out.clear();
+        for f in &p.force[..p.n_owned] {
+            out.extend_from_slice(&f.as_slice()[..n2]);
+        }
     }
 }
 
