@@ -14,6 +14,7 @@ fn main() {
         peer: false,
         repeat: 5,
         checkpoint: true,
+        savings: false,
     };
     match pdq::bench::run(&opts) {
         Ok(s) => print!("{s}"),

@@ -195,6 +195,17 @@ impl Model for Concrete {
         })
     }
 
+    fn breaks(&self) -> bool {
+        self.laws.iter().any(|l| match *l {
+            Law::Brittle {
+                tensile,
+                compressive,
+                ..
+            } => tensile.is_finite() || compressive.is_finite(),
+            Law::Plastic { failure, .. } => failure.is_finite(),
+        })
+    }
+
     fn inertia(&self, material: u16, volume: f64, _fixed: &()) -> Force3 {
         let m = self.density[material as usize] * volume;
         Force3 { force: [m; 3] }

@@ -178,6 +178,10 @@ impl Model for Lps {
         })
     }
 
+    fn breaks(&self) -> bool {
+        self.s0.iter().any(|s| s.is_finite())
+    }
+
     fn inertia(&self, material: u16, volume: f64, _: &WeightedVolume) -> Force3 {
         let m = self.density[material as usize] * volume;
         Force3 { force: [m; 3] }

@@ -272,6 +272,12 @@ impl Model for Micropolar {
         })
     }
 
+    fn breaks(&self) -> bool {
+        self.own
+            .iter()
+            .any(|o| o.tensile.is_finite() || o.compressive.is_finite())
+    }
+
     fn inertia(&self, material: u16, volume: f64, _: &()) -> Force6 {
         let m = self.density[material as usize] * volume;
         let j = m * self.spacing * self.spacing / 6.0;

@@ -129,6 +129,10 @@ impl Model for Pmb {
         })
     }
 
+    fn breaks(&self) -> bool {
+        self.laws.iter().any(|l| l.s0.is_finite())
+    }
+
     fn inertia(&self, material: u16, volume: f64, _fixed: &()) -> Force3 {
         let m = self.density[material as usize] * volume;
         Force3 { force: [m; 3] }

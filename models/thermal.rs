@@ -127,6 +127,10 @@ impl Model for Thermal {
         })
     }
 
+    fn breaks(&self) -> bool {
+        self.own.iter().any(|o| o.s0.is_finite())
+    }
+
     fn inertia(&self, material: u16, volume: f64, _: &ConductionSum) -> ForceHeat {
         let m = self.density[material as usize] * volume;
         ForceHeat {

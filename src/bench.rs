@@ -36,6 +36,8 @@ pub struct BenchOptions {
     pub rounds: usize,
     /// Also time writing one checkpoint of the scene against 100 steps (one thread).
     pub checkpoint: bool,
+    /// Instead of the standard lines: what a scene saves by not using a feature.
+    pub savings: bool,
 }
 
 const SPACING: f64 = 0.001;
@@ -123,11 +125,35 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Runs the benchmark and returns the lines it printed.
+/// Runs the benchmark and returns the lines it printed. `--model all` runs every model (the
+/// LAMMPS peer for PMB and LPS, which it has) and ends with a Markdown table.
 pub fn run(opts: &BenchOptions) -> Result<String, String> {
     if opts.threads.contains(&0) || opts.ranks.contains(&0) {
         return Err("threads and ranks must be at least 1".into());
     }
+    if opts.savings {
+        return savings(opts);
+    }
+    if opts.model == "all" {
+        let mut out = String::new();
+        for model in ALL_MODELS {
+            let one = BenchOptions {
+                model: model.into(),
+                peer: opts.peer && (model == "pmb" || model == "lps"),
+                yardstick: opts.yardstick && model == "pmb",
+                ..opts.clone()
+            };
+            out.push_str(&run(&one)?);
+        }
+        let table = suite_table(&out);
+        out.push('\n');
+        out.push_str(&table);
+        return Ok(out);
+    }
+    run_one(opts)
+}
+
+fn run_one(opts: &BenchOptions) -> Result<String, String> {
     let text = standard_deck(&opts.model, opts.n, opts.steps)?;
     let scene = deck::parse(&text, "<bench>", "bench").map_err(|e| e.to_string())?;
     struct Visit<'a>(&'a deck::Scene, &'a BenchOptions);
@@ -169,9 +195,10 @@ pub fn run(opts: &BenchOptions) -> Result<String, String> {
     Ok(out)
 }
 
-/// The standard line of one parallel run.
-fn line(
-    model: &str,
+/// The standard line of one parallel run. Memory is what the engine stores for the model's
+/// declared records: per particle (engine fields, Alter, Fixed, State, Force and inverse
+/// inertia) and per bond (partner, geometry, broken flag, history), ghosts and buffers aside.
+fn line<M: Model>(
     particles: usize,
     steps: u64,
     threads: usize,
@@ -179,15 +206,88 @@ fn line(
     t: &parallel::Timed,
 ) -> String {
     format!(
-        "bench model={model} particles={particles} steps={steps} threads={threads} ranks={ranks} us_per_particle_step={:.4} ns_per_bond={:.3} bonds={} broken={} seconds={:.3} comm_percent={:.1} bytes_per_step={:.0}",
+        "bench model={} particles={particles} steps={steps} threads={threads} ranks={ranks} us_per_particle_step={:.4} ns_per_bond={:.3} bonds_per_second={:.4e} bonds={} broken={} seconds={:.3} comm_percent={:.1} bytes_per_step={:.0} bytes_per_particle={} bytes_per_bond={}",
+        M::NAME,
         1e6 * t.seconds / (particles as f64 * steps as f64),
         1e9 * t.seconds / (t.bonds as f64 * steps as f64),
+        t.bonds as f64 * steps as f64 / t.seconds,
         t.bonds,
         t.broken,
         t.seconds,
         100.0 * t.comm_seconds / t.seconds.max(1e-300),
-        t.bytes_per_step
+        t.bytes_per_step,
+        crate::particles::Particles::<M>::bytes_per_particle(),
+        crate::bonds::BondList::<M::Bond>::bytes_per_bond(),
     )
+}
+
+/// The models `--model all` runs, in table order.
+pub const ALL_MODELS: [&str; 5] = ["pmb", "concrete", "lps", "micropolar", "thermal"];
+
+/// `key=value` of a standard line.
+fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {
+    line.split_whitespace()
+        .find_map(|w| w.strip_prefix(key)?.strip_prefix('='))
+}
+
+/// The Markdown table of a `--model all` run, from its standard lines (medians when rounds > 1).
+fn suite_table(lines: &str) -> String {
+    let mut t = String::from(
+        "| model | threads | ranks | µs per particle-step | ns per bond | bonds per second | bytes per particle | bytes per bond | LAMMPS / PDQ |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    let medians: Vec<&str> = lines
+        .lines()
+        .filter(|l| l.starts_with("bench median "))
+        .collect();
+    for l in lines.lines().filter(|l| l.starts_with("bench model=")) {
+        let get = |k| field(l, k).unwrap_or("–");
+        let (model, threads, ranks) = (get("model"), get("threads"), get("ranks"));
+        // With rounds, one row per (model, threads) carrying the median.
+        let median = medians.iter().find(|m| {
+            field(m, "model") == Some(model) && field(m, "threads") == Some(threads) && ranks == "1"
+        });
+        let us = match median {
+            Some(m) => {
+                if t.contains(&format!("| {model} | {threads} | 1 |")) {
+                    continue;
+                }
+                format!(
+                    "{} (median of {})",
+                    get_or(m, "us_per_particle_step"),
+                    get_or(m, "runs")
+                )
+            }
+            None => get("us_per_particle_step").to_string(),
+        };
+        let ratio = lines
+            .lines()
+            .filter(|r| r.starts_with("bench ratio") && threads == "1" && ranks == "1")
+            .find(|r| field(r, "(model") == Some(model))
+            .and_then(|r| field(r, "lammps/pdq"))
+            .unwrap_or("");
+        let _ = writeln!(
+            t,
+            "| {model} | {threads} | {ranks} | {us} | {} | {} | {} | {} | {ratio} |",
+            get("ns_per_bond"),
+            get("bonds_per_second"),
+            get("bytes_per_particle"),
+            get("bytes_per_bond")
+        );
+    }
+    for l in lines.lines().filter(|l| l.starts_with("bench peer=")) {
+        if let (Some(peer), Some(us)) = (field(l, "bench peer"), field(l, "us_per_particle_step")) {
+            let _ = writeln!(
+                t,
+                "| {peer} | 1 | {} | {us} | | | | | |",
+                field(l, "ranks").unwrap_or("1")
+            );
+        }
+    }
+    t
+}
+
+fn get_or<'a>(line: &'a str, key: &str) -> &'a str {
+    field(line, key).unwrap_or("–")
 }
 
 /// Under `mpirun`: this rank's procCube of the standard scene; rank 0 prints the line.
@@ -210,7 +310,7 @@ impl ModelVisitor for MpiVisit<'_> {
         Ok(if rank == 0 {
             format!(
                 "{} layout={}\n",
-                line(M::NAME, n, self.1.steps, 1, ranks, &t),
+                line::<M>(n, self.1.steps, 1, ranks, &t),
                 layout.describe().replace(' ', "_")
             )
         } else {
@@ -272,7 +372,15 @@ fn ranks_line(opts: &BenchOptions, ranks: usize) -> Result<String, String> {
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
     let out = mpirun(ranks)
         .arg(exe)
-        .args(["bench", "--model", &opts.model, "--threads", "1", "--steps"])
+        .args([
+            "bench",
+            "--model",
+            &opts.model,
+            "--threads",
+            "1",
+            "--no-yardstick",
+            "--steps",
+        ])
         .arg(opts.steps.to_string())
         .arg("--n")
         .arg(opts.n.to_string())
@@ -317,7 +425,7 @@ fn bench_setup<M: Model>(
         let timed = parallel::on_threads(cubes, |c| c.timed_steps(opts.steps));
         let t = &timed[0];
         let us = 1e6 * t.seconds / (n as f64 * opts.steps as f64);
-        let _ = write!(out, "{}", line(M::NAME, n, opts.steps, threads, 1, t));
+        let _ = write!(out, "{}", line::<M>(n, opts.steps, threads, 1, t));
         let entry = per_count.entry(threads).or_default();
         entry.0.push(us);
         if threads == 1 {
@@ -552,4 +660,102 @@ fn peer(opts: &BenchOptions, ranks: usize) -> Result<Result<(String, f64), Strin
         ),
         us,
     )))
+}
+
+/// Steps of one deck on `threads` threads (layout auto, whole walls), with a shuffle check
+/// every `shuffle_every` steps: µs per particle-step and the share of the state pass.
+fn time_deck(
+    text: &str,
+    threads: usize,
+    steps: u64,
+    shuffle_every: u64,
+) -> Result<(f64, f64), String> {
+    let scene = deck::parse(text, "<bench>", "bench").map_err(|e| e.to_string())?;
+    struct Visit<'a>(&'a deck::Scene, usize, u64, u64);
+    impl ModelVisitor for Visit<'_> {
+        type Output = Result<(f64, f64), String>;
+        fn visit<M: Model>(self, model: M) -> Self::Output {
+            let Visit(scene, threads, steps, shuffle_every) = self;
+            let setup = setup::build(model, scene).map_err(|e| e.to_string())?;
+            let n = setup.sim.particles.n_owned;
+            let layout = parallel::layout(&setup, &Procs::Auto, threads, Walls::Whole)?;
+            let cubes = parallel::thread_cubes(&setup, &layout);
+            drop(setup);
+            let timed =
+                parallel::on_threads(cubes, |c| c.timed_steps_shuffling(steps, shuffle_every));
+            let t = timed.into_iter().next().ok_or("no procCube")??;
+            let state = t.timing.get(crate::timing::Phase::State).as_secs_f64();
+            Ok((
+                1e6 * t.seconds / (n as f64 * steps as f64),
+                state / t.seconds,
+            ))
+        }
+    }
+    setup::with_model(&scene, Visit(&scene, threads, steps, shuffle_every))
+        .map_err(|e| e.to_string())?
+}
+
+/// `pdq bench --savings`: the standard scene with and without each feature a deck may leave
+/// out, alternating `rounds` times; medians and the saving.
+fn savings(opts: &BenchOptions) -> Result<String, String> {
+    let (n, steps) = (opts.n, opts.steps);
+    let pmb = standard_deck("pmb", n, steps)?;
+    let unbreakable = pmb.replace("critical_stretch = 0.0005\n", "");
+    let shuffling = format!("{pmb}[parallel]\nshuffle_every = 10\n");
+    // (feature, deck using it, threads, shuffle_every, deck without it, what differs)
+    let pairs: [(&str, String, usize, u64, String, &str); 4] = [
+        ("damage checks", pmb.clone(), 1, 0, unbreakable, "pmb with critical stretch 0.0005 against none (the engine drops the broken flags and break tests from the bond loop)"),
+        ("state pass", standard_deck("lps", n, steps)?, 1, 0, pmb.clone(), "lps against pmb, same scene: the state pass, its two exchanges and the state-based law"),
+        ("rotation DOFs", standard_deck("micropolar", n, steps)?, 1, 0, pmb.clone(), "micropolar (6 DOFs, moments) against pmb (3 DOFs), same stiffness; the difference includes the larger law"),
+        ("shuffling", shuffling, 2, 10, pmb, "pmb on 2 threads with shuffle_every = 10 (cells widened by the 0.25 skin) against small-motion mode"),
+    ];
+    let mut out = String::new();
+    let mut table = String::from("| feature | with it (µs per particle-step) | without (µs) | saving | runs | what is compared |\n|---|---|---|---|---|---|\n");
+    for (feature, used, threads, every, unused, what) in &pairs {
+        let (mut with, mut without, mut share) = (Vec::new(), Vec::new(), Vec::new());
+        for r in 0..opts.rounds.max(1) {
+            // Alternate which goes first, so a slow spell of the machine hits both.
+            let (a, b) = if r % 2 == 0 {
+                let a = time_deck(used, *threads, steps, *every)?;
+                (a, time_deck(unused, *threads, steps, 0)?)
+            } else {
+                let b = time_deck(unused, *threads, steps, 0)?;
+                (time_deck(used, *threads, steps, *every)?, b)
+            };
+            let _ = writeln!(
+                out,
+                "bench saving feature={} round={r} with_us={:.4} without_us={:.4}",
+                feature.replace(' ', "_"),
+                a.0,
+                b.0
+            );
+            with.push(a.0);
+            without.push(b.0);
+            share.push(a.1);
+        }
+        let (w, wo) = (median(with.clone()), median(without.clone()));
+        let saving = 100.0 * (w - wo) / w;
+        let _ = writeln!(
+            out,
+            "bench saving median feature={} with_us={w:.4} without_us={wo:.4} saving_percent={saving:.1} runs={}",
+            feature.replace(' ', "_"),
+            with.len()
+        );
+        let mut what = what.to_string();
+        if *feature == "state pass" {
+            let _ = write!(
+                what,
+                "; the state pass alone is {:.0} % of the lps step",
+                100.0 * median(share)
+            );
+        }
+        let _ = writeln!(
+            table,
+            "| {feature} | {w:.4} | {wo:.4} | {saving:.1} % | {} | {what} |",
+            with.len()
+        );
+    }
+    out.push('\n');
+    out.push_str(&table);
+    Ok(out)
 }

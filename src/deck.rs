@@ -133,6 +133,11 @@ struct LatticeSection {
     /// Axes that wrap around ("x", "y", "z"): the lattice box repeats along them.
     #[serde(default)]
     periodic: Vec<String>,
+    /// Random offsets of the sites, as a fraction of the spacing.
+    #[serde(default)]
+    jitter: f64,
+    #[serde(default)]
+    seed: u64,
 }
 
 #[derive(Deserialize)]
@@ -603,6 +608,19 @@ impl Converter {
             );
         }
         let lattice_periodic = deck.lattice.get_ref().periodic.clone();
+        let (jitter, seed) = (deck.lattice.get_ref().jitter, deck.lattice.get_ref().seed);
+        if !(0.0..0.5).contains(&jitter) {
+            return self.err(
+                lat_line,
+                format!("[lattice] jitter = {jitter}: give a fraction of the spacing in [0, 0.5)"),
+            );
+        }
+        if jitter > 0.0 && !lattice_periodic.is_empty() {
+            return self.err(
+                lat_line,
+                "[lattice] jitter with periodic axes is not supported (the period is taken from the particles' extent)".to_string(),
+            );
+        }
         let origin = deck
             .lattice
             .get_ref()
@@ -956,7 +974,12 @@ impl Converter {
             partial_volume: ms.partial_volume.unwrap_or(true),
             surface_correction,
             materials,
-            lattice: Lattice { spacing, origin },
+            lattice: Lattice {
+                spacing,
+                origin,
+                jitter,
+                seed,
+            },
             ops,
             op_lines,
             bars,

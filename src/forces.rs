@@ -37,7 +37,12 @@ pub fn state_pass<M: Model>(model: &M, p: &mut Particles<M>, bonds: &mut BondLis
         alter,
         state: ZeroState(&zero),
     };
-    sweep_with_laws(model, ends, bonds, state, StateOfBond(model));
+    // Broken bonds leave the state too, so it skips them like the pair pass.
+    if model.breaks() {
+        sweep_with_laws::<_, _, _, _, true>(model, ends, bonds, state, StateOfBond(model));
+    } else {
+        sweep_with_laws::<_, _, _, _, false>(model, ends, bonds, state, StateOfBond(model));
+    }
 }
 
 /// Turns summed states into final values (after the reverse sum brought ghosts' partials home).
@@ -77,13 +82,20 @@ pub fn pair_pass<M: Model>(
         alter,
         state: &state[..],
     };
-    sweep_with_laws(model, ends, bonds, force, PairOfBond(model))
+    if model.breaks() {
+        sweep_with_laws::<_, _, _, _, true>(model, ends, bonds, force, PairOfBond(model))
+    } else {
+        // Nothing can break, so nothing ever broke: a scene's bonds start intact, and a
+        // checkpoint with broken bonds belongs to another scene (its materials differ).
+        debug_assert_eq!(bonds.broken_count(), 0, "unbreakable bonds marked broken");
+        sweep_with_laws::<_, _, _, _, false>(model, ends, bonds, force, PairOfBond(model))
+    }
 }
 
 /// [`sweep`] with the model's laws. A scene of one material gets a loop with its law fixed: no
 /// material loads, no dispatch.
 #[inline(always)]
-fn sweep_with_laws<M, T, St, V>(
+fn sweep_with_laws<M, T, St, V, const DAMAGE: bool>(
     model: &M,
     ends: Ends<'_, M, St>,
     bonds: &mut BondList<M::Bond>,
@@ -99,9 +111,9 @@ where
     match single_material(ends.material) {
         Some(m) => {
             let law = model.law(m, m);
-            sweep(ends, bonds, out, |_, _| law, visit)
+            sweep::<_, _, _, _, _, DAMAGE>(ends, bonds, out, |_, _| law, visit)
         }
-        None => sweep(ends, bonds, out, |a, b| model.law(a, b), visit),
+        None => sweep::<_, _, _, _, _, DAMAGE>(ends, bonds, out, |a, b| model.law(a, b), visit),
     }
 }
 
@@ -214,9 +226,10 @@ struct Ends<'a, M: Model, St> {
 
 /// The bond loop of both passes: every intact bond of every owned particle, once, from its
 /// owner. `visit` gives the two ends' contributions, added into `out` (zeroed first), or `None`
-/// to break the bond; returns how many broke.
+/// to break the bond; returns how many broke. Without `DAMAGE` every bond is intact and stays
+/// so: the broken flags are neither read nor written (unbreakable scenes).
 #[inline(always)]
-fn sweep<M, T, St, L, V>(
+fn sweep<M, T, St, L, V, const DAMAGE: bool>(
     ends: Ends<'_, M, St>,
     bonds: &mut BondList<M::Bond>,
     out: &mut [T],
@@ -299,9 +312,9 @@ where
             // Two intact bonds at once if the model asks (`Model::PAIRED_BONDS`): two copies of
             // the same arithmetic in one block, which the compiler pairs into vector
             // instructions, one lane per bond. The sums are made in bond order either way.
-            let two = M::PAIRED_BONDS && k + 1 < len && !broken[k] && !broken[k + 1];
+            let two = M::PAIRED_BONDS && k + 1 < len && (!DAMAGE || (!broken[k] && !broken[k + 1]));
             let n = if two { 2 } else { 1 };
-            if !two && broken[k] {
+            if DAMAGE && !two && broken[k] {
                 k += 1;
                 continue;
             }
@@ -325,14 +338,14 @@ where
                 )
             });
             // SAFETY (both): partners are in bounds, as above.
-            newly_broken += add_or_break(
+            newly_broken += add_or_break::<T, DAMAGE>(
                 r1,
                 &mut oi,
                 unsafe { out.get_unchecked_mut(j1) },
                 &mut broken[k],
             );
             if let Some((j2, r2)) = r2 {
-                newly_broken += add_or_break(
+                newly_broken += add_or_break::<T, DAMAGE>(
                     r2,
                     &mut oi,
                     unsafe { out.get_unchecked_mut(j2) },
@@ -347,8 +360,9 @@ where
 }
 
 /// Adds a bond's contributions to its two ends, or marks it broken; returns how many broke.
+/// Without `DAMAGE` a `None` (which an unbreakable law never returns) adds nothing.
 #[inline(always)]
-fn add_or_break<T: Attributes>(
+fn add_or_break<T: Attributes, const DAMAGE: bool>(
     r: Option<(T, T)>,
     oi: &mut T,
     oj: &mut T,
@@ -360,10 +374,11 @@ fn add_or_break<T: Attributes>(
             add_assign(oj, &b);
             0
         }
-        None => {
+        None if DAMAGE => {
             *broken = true;
             1
         }
+        None => 0,
     }
 }
 

@@ -288,6 +288,45 @@ impl Shape {
 pub struct Lattice {
     pub spacing: f64,
     pub origin: Vec3,
+    /// Each lattice site is moved by a random offset of up to `jitter × spacing` per axis
+    /// (0: a regular lattice). Shapes select sites by their regular positions.
+    pub jitter: f64,
+    /// Seed of the offsets: the same seed gives the same scene, whatever the layout.
+    pub seed: u64,
+}
+
+impl Lattice {
+    pub fn regular(spacing: f64, origin: Vec3) -> Self {
+        Lattice {
+            spacing,
+            origin,
+            jitter: 0.0,
+            seed: 0,
+        }
+    }
+
+    /// The offset of site `key`: uniform in [−jitter·spacing, jitter·spacing) per axis, a
+    /// function of the seed and the site's integer index only (SplitMix64).
+    fn offset(&self, key: &Key) -> Vec3 {
+        if self.jitter == 0.0 {
+            return [0.0; 3];
+        }
+        let mut h = self.seed ^ 0x9E37_79B9_7F4A_7C15;
+        for k in key {
+            h = splitmix64(h ^ (*k as u64));
+        }
+        [0, 1, 2].map(|e| {
+            let u = (splitmix64(h.wrapping_add(e as u64)) >> 11) as f64 / (1u64 << 53) as f64;
+            (2.0 * u - 1.0) * self.jitter * self.spacing
+        })
+    }
+}
+
+fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -443,6 +482,12 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
             "lattice spacing must be finite and > 0, origin finite (got spacing {s}, origin {o:?})"
         )));
     }
+    if !(0.0..0.5).contains(&lattice.jitter) {
+        return Err(scene_err(format!(
+            "lattice jitter must be in [0, 0.5) spacings (got {})",
+            lattice.jitter
+        )));
+    }
     let tol = 1e-9 * s;
     let site = |key: &Key| [0, 1, 2].map(|e| o[e] + s * (key[2 - e] as f64 + 0.5));
     // Index ranges (padded by one) of the sites covering [lo, hi]; inside tests trim them.
@@ -519,7 +564,10 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
     }
 
     let mut cloud = Cloud::default();
-    let lattice_particles = filled.iter().map(|(key, &m)| (site(key), s * s * s, m, s));
+    let lattice_particles = filled.iter().map(|(key, &m)| {
+        let (p, d) = (site(key), lattice.offset(key));
+        ([p[0] + d[0], p[1] + d[1], p[2] + d[2]], s * s * s, m, s)
+    });
     for (p, volume, material, spacing) in lattice_particles.chain(bar_particles) {
         cloud.position.push(p);
         cloud.volume.push(volume);
@@ -538,14 +586,7 @@ mod tests {
     use super::*;
 
     fn run(s: f64, ops: &[Op], bars: &[Bar]) -> Result<Cloud, GeometryError> {
-        build(
-            &Lattice {
-                spacing: s,
-                origin: [0.0; 3],
-            },
-            ops,
-            bars,
-        )
+        build(&Lattice::regular(s, [0.0; 3]), ops, bars)
     }
     fn add(shape: Shape, material: u16) -> Op {
         Op::Add { shape, material }
@@ -574,6 +615,40 @@ mod tests {
     }
     fn x_bar(from: Vec3, length: f64, area: f64, spacing: f64) -> Bar {
         Bar::along(from, [1.0, 0.0, 0.0], length, area, spacing, 9)
+    }
+
+    #[test]
+    fn jitter_moves_sites_within_bound_and_repeats_with_its_seed() {
+        let ops = [add(bx([0.0; 3], [10.0, 10.0, 10.0]), 0)];
+        let lattice = |seed| Lattice {
+            jitter: 0.2,
+            seed,
+            ..Lattice::regular(1.0, [0.0; 3])
+        };
+        let regular = run(1.0, &ops, &[]).unwrap();
+        let a = build(&lattice(1), &ops, &[]).unwrap();
+        let b = build(&lattice(1), &ops, &[]).unwrap();
+        let c = build(&lattice(2), &ops, &[]).unwrap();
+        assert_eq!(a.position, b.position);
+        assert_ne!(a.position, c.position);
+        let mut largest: f64 = 0.0;
+        for (p, q) in a.position.iter().zip(&regular.position) {
+            for e in 0..3 {
+                largest = largest.max((p[e] - q[e]).abs());
+            }
+        }
+        // 3000 draws from U(−0.2, 0.2): the largest is within 1 % of the bound.
+        assert!(largest <= 0.2 && largest > 0.19, "largest offset {largest}");
+        let err = build(
+            &Lattice {
+                jitter: 0.5,
+                ..lattice(1)
+            },
+            &ops,
+            &[],
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("jitter"), "{err}");
     }
 
     #[test]

@@ -32,6 +32,7 @@ pub mod setup;
 pub mod shuffle;
 pub mod signals;
 pub mod simulation;
+pub mod stress;
 pub mod timing;
 pub mod units;
 pub mod validate;

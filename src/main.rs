@@ -65,6 +65,25 @@ enum Cmd {
         #[arg(long)]
         compare_adr: bool,
     },
+    /// Numerical stability stress tests: critical time step against the bound, energy drift,
+    /// sudden failure (docs/stability.md).
+    Stress {
+        /// Smaller and shorter runs (about a minute).
+        #[arg(long)]
+        quick: bool,
+        /// Sections to run, comma-separated: dt, drift, failure (default all).
+        #[arg(long, value_delimiter = ',')]
+        sections: Vec<String>,
+        /// Models to run, comma-separated (default all).
+        #[arg(long, value_delimiter = ',')]
+        models: Vec<String>,
+        /// Cases run side by side.
+        #[arg(long, default_value_t = 2)]
+        threads: usize,
+        /// Also write the report to this file.
+        #[arg(long)]
+        output: Option<PathBuf>,
+    },
     /// Print what a frame or checkpoint file holds: step, time, particles, attributes, bonds.
     Info { file: PathBuf },
     /// Check a deck: particles, bonds, memory, time step, and an estimated run time.
@@ -108,6 +127,10 @@ enum Cmd {
         /// Also time writing a checkpoint of the scene against 100 steps (one thread).
         #[arg(long)]
         checkpoint: bool,
+        /// Instead: the scene with and without each feature a deck may leave out (damage
+        /// checks, state pass, rotations, shuffling), `--rounds` times; prints a table.
+        #[arg(long)]
+        savings: bool,
     },
 }
 
@@ -180,6 +203,26 @@ fn main() -> ExitCode {
                 Err("an elastic case is outside its tolerance (see the table)".into())
             }
         }),
+        Cmd::Stress {
+            quick,
+            sections,
+            models,
+            threads,
+            output,
+        } => pdq::stress::run(&pdq::stress::StressOptions {
+            quick,
+            sections,
+            models,
+            threads,
+        })
+        .and_then(|report| {
+            print!("{report}");
+            match output {
+                Some(path) => std::fs::write(&path, &report)
+                    .map_err(|e| format!("writing {}: {e}", path.display())),
+                None => Ok(()),
+            }
+        }),
         Cmd::Info { file } => pdq::checkpoint::info(&file).map(|s| print!("{s}")),
         Cmd::Check { deck: path } => deck::load(&path)
             .map_err(|e| e.to_string())
@@ -202,6 +245,7 @@ fn main() -> ExitCode {
             repeat,
             rounds,
             checkpoint,
+            savings,
         } => bench::run(&bench::BenchOptions {
             model,
             threads,
@@ -219,6 +263,7 @@ fn main() -> ExitCode {
             repeat,
             rounds,
             checkpoint,
+            savings,
         })
         .map(|s| print!("{s}")),
     };

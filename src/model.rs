@@ -272,6 +272,13 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
 
     fn build(b: &ModelBuild) -> Result<Self, String>;
 
+    /// Whether a bond of this scene can break (some critical stretch is finite). When none can,
+    /// the engine runs the pair pass without damage bookkeeping: no broken flags read or
+    /// written, no break test per bond in the loop.
+    fn breaks(&self) -> bool {
+        true
+    }
+
     /// Constant data of a particle.
     fn fixed(&self, _material: u16, _volume: f64) -> Self::Fixed {
         Self::Fixed::default()

@@ -345,7 +345,18 @@ pub struct Timed {
 
 impl<M: Model> Cube<M> {
     /// Runs `steps` steps after a common start and measures them (every worker must call it).
-    pub fn timed_steps(mut self, steps: u64) -> Timed {
+    pub fn timed_steps(self, steps: u64) -> Timed {
+        self.timed_steps_shuffling(steps, 0)
+            .expect("no shuffle, nothing to fail")
+    }
+
+    /// [`Cube::timed_steps`] with a shuffle check every `shuffle_every` steps (0: never), as a
+    /// run with `[parallel] shuffle_every` makes; fails as the shuffle does.
+    pub fn timed_steps_shuffling(
+        mut self,
+        steps: u64,
+        shuffle_every: u64,
+    ) -> Result<Timed, String> {
         use crate::comm::{Reduce, Team};
         use crate::timing::Phase;
         self.start();
@@ -354,8 +365,13 @@ impl<M: Model> Cube<M> {
         // A reduction is a barrier: everyone starts the clock together.
         Team::new(self.sim.exchange.transport()).sum(0.0);
         let t = std::time::Instant::now();
-        for _ in 0..steps {
+        for step in 1..=steps {
             self.sim.advance();
+            if shuffle_every > 0 && step % shuffle_every == 0 {
+                let t = std::time::Instant::now();
+                self.shuffle()?;
+                self.sim.timing.lap(Phase::Communication, t);
+            }
         }
         let secs = t.elapsed().as_secs_f64();
         let after = self.wall().traffic;
@@ -370,13 +386,13 @@ impl<M: Model> Cube<M> {
             (after.bytes - before.bytes) as f64 / steps.max(1) as f64,
         ];
         Team::new(self.sim.exchange.transport()).reduce(&mut s, Reduce::Sum);
-        Timed {
+        Ok(Timed {
             seconds: v[0],
             comm_seconds: v[1],
             bonds: s[0] as usize,
             broken: s[1] as usize,
             bytes_per_step: s[2],
             timing: self.sim.timing.clone(),
-        }
+        })
     }
 }

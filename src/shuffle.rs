@@ -30,18 +30,28 @@ const PARTICLE_HEAD: usize = 8;
 const BOND_HEAD: usize = 5;
 
 impl<M: Model> Cube<M> {
-    /// Whether some owned particle now lies in another procCube's cells.
+    /// Whether some owned particle now lies more than a quarter cell inside another procCube's
+    /// cells. The quarter cell is hysteresis: ownership and ghost lists depend only on the
+    /// cells, never on positions, so a particle may sit just across its procCube's face without
+    /// harm, and one vibrating on a face would otherwise make every check shuffle the scene.
     fn someone_left(&mut self) -> bool {
+        const MARGIN: f64 = 0.25;
         let p = &self.sim.particles;
         let d = &self.layout.domain;
+        let g = &d.grid;
+        let (lo, hi) = (self.plan.cells.lo, self.plan.cells.hi);
         let mut left = false;
-        for i in 0..p.n_owned {
-            let c = d.grid.coords(&wrap(p.pos(i), d).0);
-            let at = [c[0] as i64, c[1] as i64, c[2] as i64];
-            let (lo, hi) = (self.plan.cells.lo, self.plan.cells.hi);
-            if (0..3).any(|a| at[a] < lo[a] || at[a] >= hi[a]) {
-                left = true;
-                break;
+        'particles: for i in 0..p.n_owned {
+            let x = wrap(p.pos(i), d).0;
+            for a in 0..3 {
+                // Matter beyond the grid counts in the edge cells (as `CellGrid::coords`).
+                let f = (x[a] - g.origin[a]) / g.size[a];
+                let below = lo[a] > 0 && f < lo[a] as f64 - MARGIN;
+                let above = (hi[a] as usize) < g.dims[a] && f >= hi[a] as f64 + MARGIN;
+                if below || above {
+                    left = true;
+                    break 'particles;
+                }
             }
         }
         Team::new(self.sim.exchange.transport()).max(if left { 1.0 } else { 0.0 }) > 0.0

@@ -1,0 +1,90 @@
+//! The stability stress tests of `pdq stress` (docs/stability.md), at sizes a test can afford.
+
+use pdq::stress::{self, Failure, Lattice, StressOptions};
+
+#[test]
+fn the_bound_is_below_the_measured_critical_step_on_every_lattice() {
+    for lattice in [Lattice::Regular, Lattice::Jittered, Lattice::SteelConcrete] {
+        for model in ["pmb", "micropolar"] {
+            let r = stress::critical_step(model, lattice, 6, 400, 6).unwrap();
+            println!(
+                "{model} {}: critical / bound between {:.3} and {:.3}",
+                lattice.name(),
+                r.lo,
+                r.hi
+            );
+            // The default safety factor 0.8 leaves a margin only if the true limit is above
+            // the bound; velocity Verlet's limit 2/ω_max is below 4 × the Gershgorin bound.
+            assert!(
+                r.lo > 1.2,
+                "{model} {}: stable only to {}",
+                lattice.name(),
+                r.lo
+            );
+            assert!(
+                r.hi < 4.0,
+                "{model} {}: no blow-up below {}",
+                lattice.name(),
+                r.hi
+            );
+        }
+    }
+}
+
+#[test]
+fn energy_stays_within_its_integration_error_over_a_long_vibration() {
+    for model in ["pmb", "lps", "thermal"] {
+        let r = stress::drift(model, 5, 4000).unwrap();
+        println!(
+            "{model}: largest |E - E0|/E0 {:.2e}, drift {:+.2e}, heat {:?}",
+            r.largest, r.drift, r.content_change
+        );
+        assert!(r.largest < 0.1, "{model}: energy strays by {}", r.largest);
+        assert!(
+            r.drift.abs() < 1e-3,
+            "{model}: energy drifts by {}",
+            r.drift
+        );
+        if let Some(c) = r.content_change {
+            assert!(c.abs() < 1e-12, "heat content changes by {c}");
+        }
+    }
+}
+
+#[test]
+fn sudden_failure_leaves_finite_state_and_bounded_energy() {
+    for case in [Failure::Cut, Failure::Shatter, Failure::Impact(1000.0)] {
+        let r = stress::failure("pmb", case, 150).unwrap();
+        println!(
+            "{}: {} of {} bonds broken, largest E/E0 {:.4}, final {:.4}",
+            case.name(),
+            r.broken,
+            r.bonds,
+            r.largest,
+            r.last
+        );
+        assert!(r.finite, "{}: non-finite state", case.name());
+        assert!(r.broken > 0, "{}: nothing broke", case.name());
+        assert!(
+            r.largest < 1.05,
+            "{}: energy grew to {}",
+            case.name(),
+            r.largest
+        );
+        assert!(r.fastest < 0.5, "{}: a particle ran away", case.name());
+    }
+}
+
+#[test]
+fn unknown_models_and_sections_are_refused_by_name() {
+    let opts = |models: &[&str], sections: &[&str]| StressOptions {
+        quick: true,
+        sections: sections.iter().map(|s| s.to_string()).collect(),
+        models: models.iter().map(|s| s.to_string()).collect(),
+        threads: 1,
+    };
+    let e = stress::run(&opts(&["pbm"], &[])).unwrap_err();
+    assert!(e.contains("'pbm'"), "{e}");
+    let e = stress::run(&opts(&[], &["speed"])).unwrap_err();
+    assert!(e.contains("'speed'"), "{e}");
+}
