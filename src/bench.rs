@@ -230,64 +230,79 @@ fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {
         .find_map(|w| w.strip_prefix(key)?.strip_prefix('='))
 }
 
-/// The Markdown table of a `--model all` run, from its standard lines (medians when rounds > 1).
+/// The Markdown table of a `--model all` run, from its standard lines: one row per model,
+/// thread or rank count and launcher, with the median over rounds.
 fn suite_table(lines: &str) -> String {
     let mut t = String::from(
-        "| model | threads | ranks | µs per particle-step | ns per bond | bonds per second | bytes per particle | bytes per bond | LAMMPS / PDQ |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| model | threads | MPI ranks | µs per particle-step (median) | runs | ns per bond | bonds per second | bytes per particle | bytes per bond | LAMMPS / PDQ |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    let medians: Vec<&str> = lines
+    let runs: Vec<&str> = lines
         .lines()
-        .filter(|l| l.starts_with("bench median "))
+        .filter(|l| l.starts_with("bench model="))
         .collect();
-    for l in lines.lines().filter(|l| l.starts_with("bench model=")) {
+    let mut seen: Vec<(String, String, bool)> = Vec::new();
+    for l in &runs {
         let get = |k| field(l, k).unwrap_or("–");
-        let (model, threads, ranks) = (get("model"), get("threads"), get("ranks"));
-        // With rounds, one row per (model, threads) carrying the median.
-        let median = medians.iter().find(|m| {
-            field(m, "model") == Some(model) && field(m, "threads") == Some(threads) && ranks == "1"
-        });
-        let us = match median {
-            Some(m) => {
-                if t.contains(&format!("| {model} | {threads} | 1 |")) {
-                    continue;
-                }
-                format!(
-                    "{} (median of {})",
-                    get_or(m, "us_per_particle_step"),
-                    get_or(m, "runs")
-                )
-            }
-            None => get("us_per_particle_step").to_string(),
+        let mpi = field(l, "launcher") == Some("mpirun");
+        let key = (
+            get("model").to_string(),
+            format!("{}/{}", get("threads"), get("ranks")),
+            mpi,
+        );
+        if seen.contains(&key) {
+            continue;
+        }
+        let same: Vec<f64> = runs
+            .iter()
+            .filter(|r| {
+                field(r, "model") == field(l, "model")
+                    && field(r, "threads") == field(l, "threads")
+                    && field(r, "ranks") == field(l, "ranks")
+                    && (field(r, "launcher") == Some("mpirun")) == mpi
+            })
+            .filter_map(|r| field(r, "us_per_particle_step")?.parse().ok())
+            .collect();
+        let us = median(same.clone());
+        let per = |k| {
+            field(l, k)
+                .and_then(|v| v.parse::<f64>().ok())
+                .unwrap_or(f64::NAN)
         };
-        let ratio = lines
-            .lines()
-            .filter(|r| r.starts_with("bench ratio") && threads == "1" && ranks == "1")
-            .find(|r| field(r, "(model") == Some(model))
-            .and_then(|r| field(r, "lammps/pdq"))
-            .unwrap_or("");
+        let (particles, bonds) = (per("particles"), per("bonds"));
+        let ns = 1e3 * us * particles / bonds;
+        let ratio = if mpi || get("threads") != "1" {
+            ""
+        } else {
+            lines
+                .lines()
+                .filter(|r| r.starts_with("bench ratio"))
+                .find(|r| field(r, "(model") == Some(key.0.as_str()))
+                .and_then(|r| field(r, "lammps/pdq"))
+                .unwrap_or("")
+        };
         let _ = writeln!(
             t,
-            "| {model} | {threads} | {ranks} | {us} | {} | {} | {} | {} | {ratio} |",
-            get("ns_per_bond"),
-            get("bonds_per_second"),
+            "| {} | {} | {} | {us:.4} | {} | {ns:.2} | {:.3e} | {} | {} | {ratio} |",
+            key.0,
+            get("threads"),
+            if mpi { get("ranks") } else { "–" },
+            same.len(),
+            1e9 / ns,
             get("bytes_per_particle"),
             get("bytes_per_bond")
         );
+        seen.push(key);
     }
     for l in lines.lines().filter(|l| l.starts_with("bench peer=")) {
         if let (Some(peer), Some(us)) = (field(l, "bench peer"), field(l, "us_per_particle_step")) {
             let _ = writeln!(
                 t,
-                "| {peer} | 1 | {} | {us} | | | | | |",
+                "| {peer} | 1 | {} | {us} | 1 | | | | | |",
                 field(l, "ranks").unwrap_or("1")
             );
         }
     }
     t
-}
-
-fn get_or<'a>(line: &'a str, key: &str) -> &'a str {
-    field(line, key).unwrap_or("–")
 }
 
 /// Under `mpirun`: this rank's procCube of the standard scene; rank 0 prints the line.
@@ -309,7 +324,7 @@ impl ModelVisitor for MpiVisit<'_> {
         let t = cube.timed_steps(self.1.steps);
         Ok(if rank == 0 {
             format!(
-                "{} layout={}\n",
+                "{} launcher=mpirun layout={}\n",
                 line::<M>(n, self.1.steps, 1, ranks, &t),
                 layout.describe().replace(' ', "_")
             )

@@ -401,7 +401,10 @@ pub enum SolverSpec {
         load_steps: u64,
         /// Converged when |residual force| ≤ tolerance × |applied force and reactions|.
         tolerance: f64,
+        /// Force evaluations per load step (ADR), Newton iterations per load step (implicit).
         max_iterations: u64,
+        /// Newton's method with the assembled tangent (`kind = "implicit"`) instead of ADR.
+        implicit: bool,
     },
 }
 
@@ -878,14 +881,17 @@ impl Converter {
                             || s.tolerance.is_some()
                             || s.max_iterations.is_some()
                         {
-                            return self.err(line, "[solver] load_steps, tolerance and max_iterations belong to kind = \"adr\"");
+                            return self.err(line, "[solver] load_steps, tolerance and max_iterations belong to kind = \"adr\" or \"implicit\"");
                         }
                         SolverSpec::Explicit
                     }
-                    "adr" => {
+                    kind @ ("adr" | "implicit") => {
+                        let implicit = kind == "implicit";
                         let load_steps = s.load_steps.unwrap_or(10);
-                        let tolerance = s.tolerance.unwrap_or(1e-4);
-                        let max_iterations = s.max_iterations.unwrap_or(100_000);
+                        let tolerance = s.tolerance.unwrap_or(if implicit { 1e-8 } else { 1e-4 });
+                        let max_iterations =
+                            s.max_iterations
+                                .unwrap_or(if implicit { 20 } else { 100_000 });
                         if load_steps == 0 || max_iterations == 0 {
                             return self
                                 .err(line, "[solver] load_steps and max_iterations must be ≥ 1");
@@ -897,13 +903,14 @@ impl Converter {
                             load_steps,
                             tolerance,
                             max_iterations,
+                            implicit,
                         }
                     }
                     other => {
                         return self.err(
                             line,
                             format!(
-                                "[solver] unknown kind '{other}' (use \"explicit\" or \"adr\")"
+                                "[solver] unknown kind '{other}' (use \"explicit\", \"adr\" or \"implicit\")"
                             ),
                         )
                     }

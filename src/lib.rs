@@ -19,6 +19,7 @@ pub mod deck;
 pub mod decomposition;
 pub mod forces;
 pub mod geometry;
+pub mod implicit;
 pub mod model;
 #[path = "../models/mod.rs"]
 pub mod models;

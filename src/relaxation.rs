@@ -216,11 +216,12 @@ impl<M: Model> Cube<M> {
     }
 }
 
-/// Refuses what relaxation cannot do, naming the reason.
-pub fn check_model<M: Model>() -> Result<(), String> {
+/// Refuses what relaxation (or the implicit solve) cannot do, naming the reason.
+pub fn check_model<M: Model>(implicit: bool) -> Result<(), String> {
     if M::FIRST_ORDER > 0 {
         return Err(format!(
-            "[solver] kind = \"adr\" relaxes mechanical degrees of freedom; model '{}' has {} first-order one(s) (temperature): use the explicit solver",
+            "[solver] kind = \"{}\" solves for mechanical equilibrium; model '{}' has {} first-order degree(s) of freedom (temperature): use the explicit solver",
+            if implicit { "implicit" } else { "adr" },
             M::NAME,
             M::FIRST_ORDER
         ));

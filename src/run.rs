@@ -111,6 +111,19 @@ fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
     c
 }
 
+/// A quasi-static solver: each step is a load step solved to equilibrium.
+#[derive(Clone)]
+enum QuasiStatic {
+    /// Adaptive dynamic relaxation with these fictitious masses by global id.
+    Adr {
+        mass: Vec<f64>,
+        tolerance: f64,
+        max_iterations: u64,
+    },
+    /// Newton's method with the assembled tangent (`src/implicit.rs`).
+    Implicit { tolerance: f64, max_iterations: u64 },
+}
+
 /// x, y, z for translations, else the model's name of the generalized force (`moment_x`,
 /// `heat`).
 fn dof_name<M: Model>(d: usize) -> String {
@@ -351,8 +364,8 @@ struct Plan {
     layout: String,
     /// The step the loop starts from: 0, or the step of the checkpoint it resumes.
     first_step: u64,
-    /// Relaxation: fictitious masses by global id, tolerance, iteration limit.
-    relaxation: Option<(Vec<f64>, f64, u64)>,
+    /// A quasi-static solver, if the deck asks for one (else explicit time steps).
+    relaxation: Option<QuasiStatic>,
     /// For the blow-up diagnosis: the stable time step and the material names.
     dt_critical: f64,
     material_names: Vec<String>,
@@ -436,6 +449,7 @@ fn drive<M: Model>(
     let mut interrupted = None;
     let (mut evaluations, mut converged) = (0u64, 0u64);
     let mut relaxed: Option<crate::relaxation::Relaxed> = None;
+    let mut tangent: Option<crate::implicit::Tangent> = None;
     let workers = cube.sim.exchange.transport().size();
     let mut progress = Progress::new(plan.steps, root && plan.progress && !plan.quiet);
     let wall = Instant::now();
@@ -443,17 +457,26 @@ fn drive<M: Model>(
     let mut shuffles = 0u64;
     for step in first..=plan.steps {
         if step > first {
-            match &plan.relaxation {
+            let r = match &plan.relaxation {
                 None => {
                     cube.sim.advance();
                     evaluations += 1;
+                    None
                 }
-                Some((mass, tolerance, max_iterations)) => {
-                    let r = cube.relax_step(mass, *tolerance, *max_iterations);
-                    evaluations += r.iterations;
-                    converged += r.converged as u64;
-                    relaxed = Some(r);
-                }
+                Some(QuasiStatic::Adr {
+                    mass,
+                    tolerance,
+                    max_iterations,
+                }) => Some(cube.relax_step(mass, *tolerance, *max_iterations)),
+                Some(QuasiStatic::Implicit {
+                    tolerance,
+                    max_iterations,
+                }) => Some(cube.implicit_step(&mut tangent, *tolerance, *max_iterations)?),
+            };
+            if let Some(r) = r {
+                evaluations += r.iterations;
+                converged += r.converged as u64;
+                relaxed = Some(r);
             }
             if plan.shuffle_every > 0 && step % plan.shuffle_every == 0 {
                 let t = Instant::now();
@@ -778,13 +801,26 @@ fn run_setup<M: Model>(
         SolverSpec::Relaxation {
             tolerance,
             max_iterations,
+            implicit,
             ..
         } => {
-            crate::relaxation::check_model::<M>()
+            crate::relaxation::check_model::<M>(implicit)
                 .map_err(|e| format!("{}:{}: {e}", scene.file, scene.solver_line))?;
-            let sim = &setup.sim;
-            let mass = crate::relaxation::fictitious_mass(&sim.model, &sim.particles, &sim.bonds);
-            Some((mass, tolerance, max_iterations))
+            if implicit {
+                Some(QuasiStatic::Implicit {
+                    tolerance,
+                    max_iterations,
+                })
+            } else {
+                let sim = &setup.sim;
+                let mass =
+                    crate::relaxation::fictitious_mass(&sim.model, &sim.particles, &sim.bonds);
+                Some(QuasiStatic::Adr {
+                    mass,
+                    tolerance,
+                    max_iterations,
+                })
+            }
         }
     };
     let scene_hash = checkpoint::scene_hash(&setup, scene);
@@ -802,6 +838,17 @@ fn run_setup<M: Model>(
             c.broken.len()
         );
     }
+    // The implicit solve assembles one matrix in one process.
+    let one_cube = |layout: &Layout| -> Result<(), String> {
+        let cubes: usize = layout.procs.iter().product();
+        if matches!(relaxation, Some(QuasiStatic::Implicit { .. })) && cubes > 1 {
+            return Err(format!(
+                "{}:{}: [solver] kind = \"implicit\" runs on one procCube, the layout has {cubes} (--threads 1, no mpirun); use kind = \"adr\" for several",
+                scene.file, scene.solver_line
+            ));
+        }
+        Ok(())
+    };
     let plan = |layout: &Layout| Plan {
         columns: columns(&setup),
         dir: dir.clone(),
@@ -834,6 +881,7 @@ fn run_setup<M: Model>(
         let mpi = crate::comm_mpi::Mpi::init().ok_or("MPI was already initialized")?;
         let (rank, ranks) = (mpi.rank(), mpi.size());
         let layout = choose_layout(&setup, scene, opts, ranks)?;
+        one_cube(&layout)?;
         // Every rank makes the directory (the same one, on a shared file system), so that a
         // failure stops them all instead of leaving some waiting for the root.
         let quiet = RunOptions {
@@ -858,6 +906,7 @@ fn run_setup<M: Model>(
 
     let threads = opts.threads.unwrap_or(scene.parallel.threads);
     let layout = choose_layout(&setup, scene, opts, threads)?;
+    one_cube(&layout)?;
     prepare(&setup, scene, opts, &dir, &layout, "threads", threads)?;
     let cubes = parallel::thread_cubes(&setup, &layout);
     let p = plan(&layout);

@@ -1,0 +1,499 @@
+//! Implicit static solve: Newton's method on the equilibrium equations with the tangent
+//! stiffness assembled as a sparse matrix and factored by `faer` (sparse Cholesky, LU if the
+//! matrix is not positive definite). For elastic states it reaches equilibrium in a few force
+//! evaluations per load step where relaxation needs thousands.
+//!
+//! The tangent is assembled from the engine's own force evaluation, for every model alike
+//! (bond-based, state-based, micropolar): columns by central differences, many at once. Two
+//! particles may be perturbed together when no particle's force depends on both: forces reach
+//! one bond length for a bond-based model and two for a model with a state pass (a state sums
+//! over a family), so particles more than twice that reach apart share a "colour". Each colour
+//! costs 2 force evaluations per degree of freedom. Rotations are perturbed through the model's
+//! own `drift`, so finite-rotation coordinates (quaternions) are handled as the integrator
+//! handles them.
+//!
+//! The tangent is kept while the bonds stay as they are and rebuilt when bonds break (modified
+//! Newton). Loads are dead loads; supported DOFs are eliminated (their motion is imposed
+//! before the iterations, as in relaxation). One procCube only: the matrix is assembled and
+//! factored in one process.
+
+use crate::attributes::Attributes;
+use crate::comm::{Reduce, Team};
+use crate::model::{second_order, Model, Side};
+use crate::parallel::Cube;
+use crate::particles::Particles;
+use crate::relaxation::Relaxed;
+use crate::timing::Phase;
+use faer::prelude::Solve;
+use faer::sparse::{SparseColMat, Triplet};
+use std::time::Instant;
+
+/// Relative size of the finite-difference perturbation: of the shortest bond for lengths, in
+/// radians for rotations.
+const PERTURBATION: f64 = 1e-6;
+
+enum Factor {
+    Cholesky(faer::sparse::linalg::solvers::Llt<usize, f64>),
+    Lu(Box<faer::sparse::linalg::solvers::Lu<usize, f64>>),
+}
+
+/// The factored tangent stiffness over the free degrees of freedom.
+pub struct Tangent {
+    /// Free DOF index of (particle · n₂ + k), or `usize::MAX` for a supported one.
+    index: Vec<usize>,
+    free: usize,
+    factor: Factor,
+    /// Broken bonds when it was assembled: a new break makes it stale.
+    broken: usize,
+    /// Force evaluations the assembly took.
+    pub evaluations: u64,
+    pub nonzeros: usize,
+    pub colours: usize,
+    /// "Cholesky" or "LU".
+    pub method: &'static str,
+    pub seconds: f64,
+}
+
+/// Particles in colours: no two of a colour within `2 × reach` of each other (reference
+/// positions), greedily in store order.
+fn colour(x0: &[[f64; 3]], reach: f64) -> Vec<Vec<usize>> {
+    let d = 2.0 * reach * (1.0 + 1e-9);
+    let lo = x0.iter().fold([f64::INFINITY; 3], |m, p| {
+        [m[0].min(p[0]), m[1].min(p[1]), m[2].min(p[2])]
+    });
+    let key = |p: &[f64; 3]| [0, 1, 2].map(|a| ((p[a] - lo[a]) / d).floor() as i64);
+    let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
+    for (i, p) in x0.iter().enumerate() {
+        cells.entry(key(p)).or_default().push(i);
+    }
+    let mut of = vec![usize::MAX; x0.len()];
+    let mut colours: Vec<Vec<usize>> = Vec::new();
+    let mut taken: Vec<bool> = Vec::new();
+    for (i, p) in x0.iter().enumerate() {
+        taken.iter_mut().for_each(|t| *t = false);
+        let c = key(p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(list) = cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                        continue;
+                    };
+                    for &j in list {
+                        let q = x0[j];
+                        let r2 = (0..3).map(|a| (q[a] - p[a]).powi(2)).sum::<f64>();
+                        if of[j] != usize::MAX && r2 <= d * d {
+                            taken[of[j]] = true;
+                        }
+                    }
+                }
+            }
+        }
+        let k = taken.iter().position(|t| !t).unwrap_or(colours.len());
+        if k == colours.len() {
+            colours.push(Vec::new());
+            taken.push(false);
+        }
+        colours[k].push(i);
+        of[i] = k;
+    }
+    colours
+}
+
+/// Moves DOF `k` of a particle by `amount` through the model's drift (a rotation composes).
+fn nudge<M: Model>(model: &M, a: &mut M::Alter, k: usize, amount: f64) {
+    let n2 = second_order::<M>();
+    let s = a.as_mut_slice();
+    let saved: Vec<f64> = s[n2..2 * n2].to_vec();
+    s[n2..2 * n2].fill(0.0);
+    s[n2 + k] = amount;
+    model.drift(a, 1.0);
+    a.as_mut_slice()[n2..2 * n2].copy_from_slice(&saved);
+}
+
+/// The tangent of a model without a state pass, bond by bond: each intact bond's forces on
+/// its two ends depend on those two ends only, so central differences of `Model::pair` give
+/// the bond's 2n₂ × 2n₂ block, 4n₂ bond calls per bond (as many as 4n₂ force passes). Lower
+/// triangle, as triplets over the free DOFs.
+fn bond_blocks<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &crate::bonds::BondList<M::Bond>,
+    index: &[usize],
+    h_length: f64,
+) -> Vec<Triplet<usize, usize, f64>> {
+    let n2 = second_order::<M>();
+    let w = 2 * n2;
+    let mut diagonal = vec![0.0; p.n_owned * n2 * n2];
+    let mut triplets = Vec::new();
+    let mut block = vec![0.0; w * w];
+    let (mut plus, mut minus) = (vec![0.0; w], vec![0.0; w]);
+    for (i, j, b) in bonds.iter() {
+        if bonds.broken[b] {
+            continue;
+        }
+        let law = model.law(p.material[i], p.material[j]);
+        for col in 0..w {
+            let (end, k) = (col / n2, col % n2);
+            let h = if k < 3 { h_length } else { PERTURBATION };
+            for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                let (mut ai, mut aj) = (p.alter[i], p.alter[j]);
+                nudge(model, if end == 0 { &mut ai } else { &mut aj }, k, sign * h);
+                let side = |e: usize, a| Side::<M> {
+                    x0: &p.x0[e],
+                    volume: p.volume[e],
+                    material: p.material[e],
+                    alter: a,
+                    fixed: &p.fixed[e],
+                    state: &p.state[e],
+                };
+                let mut history = bonds.history[b];
+                // A bond that would break under the nudge contributes nothing either way.
+                let (fi, fj) = model
+                    .pair(
+                        &law,
+                        &side(i, &ai),
+                        &side(j, &aj),
+                        &bonds.geom[b],
+                        &mut history,
+                    )
+                    .unwrap_or_default();
+                out[..n2].copy_from_slice(&fi.as_slice()[..n2]);
+                out[n2..].copy_from_slice(&fj.as_slice()[..n2]);
+            }
+            for row in 0..w {
+                block[row * w + col] = -(plus[row] - minus[row]) / (2.0 * h);
+            }
+        }
+        let particle = [i, j];
+        for row in 0..w {
+            for col in 0..w {
+                let (pr, pc) = (particle[row / n2], particle[col / n2]);
+                let v = block[row * w + col];
+                if pr == pc {
+                    diagonal[(pr * n2 + row % n2) * n2 + col % n2] += v;
+                    continue;
+                }
+                let (r, c) = (index[pr * n2 + row % n2], index[pc * n2 + col % n2]);
+                if r != usize::MAX && c != usize::MAX && r >= c && v != 0.0 {
+                    triplets.push(Triplet::new(r, c, v));
+                }
+            }
+        }
+    }
+    for i in 0..p.n_owned {
+        for k in 0..n2 {
+            for l in 0..n2 {
+                let (r, c) = (index[i * n2 + k], index[i * n2 + l]);
+                let v = diagonal[(i * n2 + k) * n2 + l];
+                if r != usize::MAX && c != usize::MAX && r >= c && v != 0.0 {
+                    triplets.push(Triplet::new(r, c, v));
+                }
+            }
+        }
+    }
+    triplets
+}
+
+/// Factors the lower triangle given as triplets: Cholesky, else LU of the whole matrix.
+fn factor(
+    triplets: Vec<Triplet<usize, usize, f64>>,
+    index: Vec<usize>,
+    free: usize,
+    broken: usize,
+    evaluations: u64,
+    colours: usize,
+    start: Instant,
+) -> Result<Tangent, String> {
+    let nonzeros = triplets.len();
+    let lower = SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &triplets)
+        .map_err(|e| format!("assembling the tangent stiffness: {e:?}"))?;
+    let (factor, method) = match lower.sp_cholesky(faer::Side::Lower) {
+        Ok(f) => (Factor::Cholesky(f), "Cholesky"),
+        Err(_) => {
+            // Not positive definite (a model without a potential, or a mechanism): LU of
+            // the whole matrix.
+            let mut full = triplets.clone();
+            full.extend(
+                triplets
+                    .iter()
+                    .filter(|t| t.row != t.col)
+                    .map(|t| Triplet::new(t.col, t.row, t.val)),
+            );
+            let a = SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &full)
+                .map_err(|e| format!("assembling the tangent stiffness: {e:?}"))?;
+            let lu = a.sp_lu().map_err(|e| {
+                format!("the tangent stiffness is singular ({e:?}): the supports leave a rigid-body motion or a loose particle free; support the body or use kind = \"adr\"")
+            })?;
+            (Factor::Lu(Box::new(lu)), "LU")
+        }
+    };
+    Ok(Tangent {
+        index,
+        free,
+        factor,
+        broken,
+        evaluations,
+        nonzeros,
+        colours,
+        method,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+impl<M: Model> Cube<M> {
+    /// Assembles and factors the tangent stiffness at the current state. Bonds, their
+    /// history and the forces are left as they were.
+    pub fn assemble_tangent(&mut self) -> Result<Tangent, String> {
+        let start = Instant::now();
+        let n2 = second_order::<M>();
+        let n = self.sim.particles.n_owned;
+        if self.layout.domain.periodic.iter().any(|&p| p) {
+            return Err("the implicit solve does not handle periodic axes (it finds who feels whom from reference positions); use kind = \"adr\"".into());
+        }
+        if self.sim.particles.len() != n || self.sim.exchange.transport().size() != 1 {
+            return Err("the implicit solve runs on one procCube (--threads 1, no mpirun): the tangent is assembled and factored in one process".into());
+        }
+        // Supported DOFs.
+        let mut index = vec![0usize; n * n2];
+        for c in &self.sim.constraints {
+            for &i in &c.particles {
+                for &k in c.dofs.iter().filter(|&&k| k < n2) {
+                    index[i as usize * n2 + k] = usize::MAX;
+                }
+            }
+        }
+        let mut free = 0;
+        for v in index.iter_mut() {
+            if *v != usize::MAX {
+                *v = free;
+                free += 1;
+            }
+        }
+        // Reach of a particle's force: the longest bond, twice over a state pass.
+        let sim = &self.sim;
+        let (mut longest, mut shortest) = (0.0f64, f64::INFINITY);
+        for g in &sim.bonds.geom {
+            longest = longest.max(g.length);
+            shortest = shortest.min(g.length);
+        }
+        if longest == 0.0 {
+            return Err("the implicit solve needs bonds: the scene has none".into());
+        }
+        if <M::State as Attributes>::LEN == 0 {
+            let triplets = bond_blocks(
+                &sim.model,
+                &sim.particles,
+                &sim.bonds,
+                &index,
+                PERTURBATION * shortest,
+            );
+            let broken = sim.bonds.broken_count();
+            return factor(triplets, index, free, broken, 4 * n2 as u64, 0, start);
+        }
+        // A state sums over a family: forces reach two bond lengths.
+        let reach = 2.0 * longest;
+        let colours = colour(&sim.particles.x0[..n], reach);
+        // Who can feel a particle: particles within `reach` (reference positions).
+        let x0 = sim.particles.x0[..n].to_vec();
+        let cell = reach * (1.0 + 1e-9);
+        let key = |p: &[f64; 3]| [0, 1, 2].map(|a| (p[a] / cell).floor() as i64);
+        let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
+        for (i, p) in x0.iter().enumerate() {
+            cells.entry(key(p)).or_default().push(i);
+        }
+        let near = |i: usize, out: &mut Vec<usize>| {
+            out.clear();
+            let (p, c) = (x0[i], key(&x0[i]));
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        if let Some(list) = cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                            for &j in list {
+                                let r2 = (0..3).map(|a| (x0[j][a] - p[a]).powi(2)).sum::<f64>();
+                                if r2 <= cell * cell {
+                                    out.push(j);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        };
+
+        let saved_alter = self.sim.particles.alter.clone();
+        let saved_broken = self.sim.bonds.broken.clone();
+        let saved_history = self.sim.bonds.history.clone();
+        let broken = saved_broken.iter().filter(|&&b| b).count();
+        let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
+        let mut plus = vec![0.0; n * n2];
+        let mut rows = Vec::new();
+        let mut evaluations = 0u64;
+        let owned = |p: &Particles<M>, out: &mut Vec<f64>| {
+            for (i, f) in p.force[..n].iter().enumerate() {
+                out[i * n2..(i + 1) * n2].copy_from_slice(&f.as_slice()[..n2]);
+            }
+        };
+        let mut minus = vec![0.0; n * n2];
+        for members in &colours {
+            for k in 0..n2 {
+                let h = if k < 3 {
+                    PERTURBATION * shortest
+                } else {
+                    PERTURBATION
+                };
+                let free_members: Vec<usize> = members
+                    .iter()
+                    .copied()
+                    .filter(|&i| index[i * n2 + k] != usize::MAX)
+                    .collect();
+                if free_members.is_empty() {
+                    continue;
+                }
+                for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                    let sim = &mut self.sim;
+                    for &i in &free_members {
+                        sim.particles.alter[i] = saved_alter[i];
+                        nudge(&sim.model, &mut sim.particles.alter[i], k, sign * h);
+                    }
+                    sim.compute_forces();
+                    evaluations += 1;
+                    owned(&sim.particles, out);
+                    for &i in &free_members {
+                        sim.particles.alter[i] = saved_alter[i];
+                    }
+                }
+                for &i in &free_members {
+                    let col = index[i * n2 + k];
+                    near(i, &mut rows);
+                    for &j in &rows {
+                        for l in 0..n2 {
+                            let row = index[j * n2 + l];
+                            if row == usize::MAX || row < col {
+                                continue; // the lower triangle is what Cholesky reads
+                            }
+                            // K = −∂F/∂u.
+                            let v = -(plus[j * n2 + l] - minus[j * n2 + l]) / (2.0 * h);
+                            if v != 0.0 {
+                                triplets.push(Triplet::new(row, col, v));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        self.sim.particles.alter = saved_alter;
+        self.sim.bonds.broken = saved_broken;
+        self.sim.bonds.history = saved_history;
+        self.sim.compute_forces();
+        factor(
+            triplets,
+            index,
+            free,
+            broken,
+            evaluations,
+            colours.len(),
+            start,
+        )
+    }
+
+    /// One load step of the implicit solve: supports and loads move to `sim.time + sim.dt`,
+    /// then Newton iterations with the (re)assembled tangent until the residual force is below
+    /// `tolerance` × (applied forces and reactions), as relaxation measures it.
+    pub fn implicit_step(
+        &mut self,
+        tangent: &mut Option<Tangent>,
+        tolerance: f64,
+        max_iterations: u64,
+    ) -> Result<Relaxed, String> {
+        let n2 = second_order::<M>();
+        let n = self.sim.particles.n_owned;
+        let (t0, dt) = (self.sim.time, self.sim.dt);
+        let start = Instant::now();
+        let zero_velocities = |p: &mut Particles<M>| {
+            for a in &mut p.alter[..p.n_owned] {
+                a.as_mut_slice()[n2..2 * n2].fill(0.0);
+            }
+        };
+        zero_velocities(&mut self.sim.particles);
+        for c in &self.sim.constraints {
+            c.set_drift_velocity(&mut self.sim.particles, t0, dt);
+        }
+        {
+            let sim = &mut self.sim;
+            for a in &mut sim.particles.alter[..n] {
+                sim.model.drift(a, dt);
+            }
+        }
+        zero_velocities(&mut self.sim.particles);
+        self.sim.time = t0 + dt;
+        self.sim.step += 1;
+        self.sim.timing.lap(Phase::Integration, start);
+
+        let mut evaluations = 0u64;
+        let mut newton = 0u64;
+        let mut residual;
+        loop {
+            self.sim.compute_forces();
+            evaluations += 1;
+            let t = Instant::now();
+            let p = &self.sim.particles;
+            let mut sums = vec![0.0];
+            for f in &p.force[..n] {
+                sums[0] += f.as_slice()[..n2].iter().map(|v| v * v).sum::<f64>();
+            }
+            for l in &self.sim.loads {
+                sums.extend_from_slice(&l.total(self.sim.time));
+            }
+            for c in &self.sim.constraints {
+                sums.extend_from_slice(&c.reaction);
+            }
+            Team::new(self.sim.exchange.transport()).reduce(&mut sums, Reduce::Sum);
+            let scale = sums[1..].iter().map(|x| x * x).sum::<f64>().sqrt();
+            residual = sums[0].sqrt() / scale.max(f64::MIN_POSITIVE);
+            self.sim.timing.lap(Phase::Integration, t);
+            if residual <= tolerance || newton >= max_iterations {
+                break;
+            }
+            let broken = self.sim.bonds.broken_count();
+            if tangent.as_ref().is_none_or(|k| k.broken != broken) {
+                let k = self.assemble_tangent()?;
+                evaluations += k.evaluations;
+                *tangent = Some(k);
+            }
+            let t = Instant::now();
+            let k = tangent.as_ref().expect("assembled above");
+            let mut rhs = faer::Mat::<f64>::zeros(k.free, 1);
+            let p = &self.sim.particles;
+            for (i, f) in p.force[..n].iter().enumerate() {
+                for (l, &f) in f.as_slice()[..n2].iter().enumerate() {
+                    let r = k.index[i * n2 + l];
+                    if r != usize::MAX {
+                        rhs[(r, 0)] = f;
+                    }
+                }
+            }
+            match &k.factor {
+                Factor::Cholesky(f) => f.solve_in_place(rhs.as_mut()),
+                Factor::Lu(f) => f.solve_in_place(rhs.as_mut()),
+            }
+            // u += K⁻¹F, through the model's drift (rotations compose).
+            let sim = &mut self.sim;
+            for i in 0..n {
+                let a = sim.particles.alter[i].as_mut_slice();
+                for l in 0..n2 {
+                    let r = k.index[i * n2 + l];
+                    a[n2 + l] = if r == usize::MAX { 0.0 } else { rhs[(r, 0)] };
+                }
+                sim.model.drift(&mut sim.particles.alter[i], 1.0);
+            }
+            zero_velocities(&mut sim.particles);
+            newton += 1;
+            sim.timing.lap(Phase::Integration, t);
+        }
+        Ok(Relaxed {
+            iterations: evaluations,
+            residual,
+            converged: residual <= tolerance,
+        })
+    }
+}
