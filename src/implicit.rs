@@ -432,6 +432,7 @@ impl<M: Model> Cube<M> {
         let mut evaluations = 0u64;
         let mut newton = 0u64;
         let mut residual;
+        let mut previous = f64::INFINITY;
         loop {
             self.sim.compute_forces();
             evaluations += 1;
@@ -454,8 +455,13 @@ impl<M: Model> Cube<M> {
             if residual <= tolerance || newton >= max_iterations {
                 break;
             }
+            let last_residual = std::mem::replace(&mut previous, residual);
+            // Rebuilt when bonds broke since, or when the last step did not halve the
+            // residual: the tangent of an earlier state (modified Newton) no longer serves,
+            // as when the structure's rotations grow (geometric stiffness).
             let broken = self.sim.bonds.broken_count();
-            if tangent.as_ref().is_none_or(|k| k.broken != broken) {
+            let slow = newton > 0 && residual > 0.5 * last_residual;
+            if slow || tangent.as_ref().is_none_or(|k| k.broken != broken) {
                 let k = self.assemble_tangent()?;
                 evaluations += k.evaluations;
                 *tangent = Some(k);

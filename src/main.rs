@@ -64,6 +64,9 @@ enum Cmd {
         /// (force evaluations to the same residual).
         #[arg(long)]
         compare_adr: bool,
+        /// Quasi-static solver of the cases: "adr" or "implicit" (one thread).
+        #[arg(long, default_value = "adr", value_parser = ["adr", "implicit"])]
+        solver: String,
     },
     /// Numerical stability stress tests: critical time step against the bound, energy drift,
     /// sudden failure (docs/stability.md).
@@ -185,7 +188,9 @@ fn main() -> ExitCode {
             output,
             threads,
             compare_adr: false,
+            solver,
         } => pdq::validate::run_all(&pdq::validate::ValidateOptions {
+            implicit: solver == "implicit",
             level: if full {
                 pdq::validate::Level::Full
             } else {

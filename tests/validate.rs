@@ -12,6 +12,7 @@ fn out(name: &str) -> std::path::PathBuf {
 fn an_unknown_case_is_refused_with_the_list() {
     let e = validate::run_all(&ValidateOptions {
         level: Level::Quick,
+        implicit: false,
         only: vec!["cantilever_steel".into()],
         output: out("unknown"),
         threads: 1,
