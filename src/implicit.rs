@@ -407,27 +407,7 @@ impl<M: Model> Cube<M> {
     ) -> Result<Relaxed, String> {
         let n2 = second_order::<M>();
         let n = self.sim.particles.n_owned;
-        let (t0, dt) = (self.sim.time, self.sim.dt);
-        let start = Instant::now();
-        let zero_velocities = |p: &mut Particles<M>| {
-            for a in &mut p.alter[..p.n_owned] {
-                a.as_mut_slice()[n2..2 * n2].fill(0.0);
-            }
-        };
-        zero_velocities(&mut self.sim.particles);
-        for c in &self.sim.constraints {
-            c.set_drift_velocity(&mut self.sim.particles, t0, dt);
-        }
-        {
-            let sim = &mut self.sim;
-            for a in &mut sim.particles.alter[..n] {
-                sim.model.drift(a, dt);
-            }
-        }
-        zero_velocities(&mut self.sim.particles);
-        self.sim.time = t0 + dt;
-        self.sim.step += 1;
-        self.sim.timing.lap(Phase::Integration, start);
+        self.begin_load_step();
 
         let mut evaluations = 0u64;
         let mut newton = 0u64;
@@ -492,7 +472,7 @@ impl<M: Model> Cube<M> {
                 }
                 sim.model.drift(&mut sim.particles.alter[i], 1.0);
             }
-            zero_velocities(&mut sim.particles);
+            crate::relaxation::zero_velocities(&mut sim.particles);
             newton += 1;
             sim.timing.lap(Phase::Integration, t);
         }

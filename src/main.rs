@@ -67,6 +67,22 @@ enum Cmd {
         /// Quasi-static solver of the cases: "adr" or "implicit" (one thread).
         #[arg(long, default_value = "adr", value_parser = ["adr", "implicit"])]
         solver: String,
+        /// Instead of the cases: the elastic cantilever swept over resolution, m and solver;
+        /// error against run time (sweep.md, sweep.png).
+        #[arg(long)]
+        sweep: bool,
+        /// Sweep: models, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "pmb,lps")]
+        models: Vec<String>,
+        /// Sweep: lattice planes across the section (odd), comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "5,7,9")]
+        planes: Vec<usize>,
+        /// Sweep: horizon ratios m, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "2,3,4")]
+        m: Vec<f64>,
+        /// Sweep: solvers, comma-separated (implicit, adr).
+        #[arg(long, value_delimiter = ',', default_value = "implicit")]
+        solvers: Vec<String>,
     },
     /// Numerical stability stress tests: critical time step against the bound, energy drift,
     /// sudden failure (docs/stability.md).
@@ -177,6 +193,15 @@ fn main() -> ExitCode {
             }),
         Cmd::Validate {
             output,
+            sweep: true,
+            models,
+            planes,
+            m,
+            solvers,
+            ..
+        } => pdq::validate::sweep(&output, &models, &planes, &m, &solvers).map(|s| print!("{s}")),
+        Cmd::Validate {
+            output,
             threads,
             compare_adr: true,
             ..
@@ -189,6 +214,7 @@ fn main() -> ExitCode {
             threads,
             compare_adr: false,
             solver,
+            ..
         } => pdq::validate::run_all(&pdq::validate::ValidateOptions {
             implicit: solver == "implicit",
             level: if full {

@@ -69,7 +69,37 @@ fn displacement<M: Model>(p: &Particles<M>, i: usize, k: usize) -> f64 {
     }
 }
 
+/// Sets every owned particle's velocities to zero: quasi-static solvers start and end each
+/// load step at rest.
+pub fn zero_velocities<M: Model>(p: &mut Particles<M>) {
+    let n2 = second_order::<M>();
+    for a in &mut p.alter[..p.n_owned] {
+        a.as_mut_slice()[n2..2 * n2].fill(0.0);
+    }
+}
+
 impl<M: Model> Cube<M> {
+    /// The start of a quasi-static load step (relaxation or the implicit solve): supports to
+    /// their positions at the end of the step (a displacement history lands exactly; a velocity
+    /// moves them by v·Δt), free particles held, the clock to the step's end.
+    pub fn begin_load_step(&mut self) {
+        let n = self.sim.particles.n_owned;
+        let (t0, dt) = (self.sim.time, self.sim.dt);
+        let start = Instant::now();
+        zero_velocities(&mut self.sim.particles);
+        for c in &self.sim.constraints {
+            c.set_drift_velocity(&mut self.sim.particles, t0, dt);
+        }
+        let sim = &mut self.sim;
+        for a in &mut sim.particles.alter[..n] {
+            sim.model.drift(a, dt);
+        }
+        zero_velocities(&mut self.sim.particles);
+        self.sim.time = t0 + dt;
+        self.sim.step += 1;
+        self.sim.timing.lap(Phase::Integration, start);
+    }
+
     /// One load step of adaptive dynamic relaxation: supports and loads move to time
     /// `sim.time + sim.dt`, then the particles relax to equilibrium. `mass_by_gid` is
     /// [`fictitious_mass`]. Every worker must call it.
@@ -81,29 +111,8 @@ impl<M: Model> Cube<M> {
     ) -> Relaxed {
         let n2 = second_order::<M>();
         let n = self.sim.particles.n_owned;
-        let (t0, dt) = (self.sim.time, self.sim.dt);
+        self.begin_load_step();
         let start = Instant::now();
-
-        // Supports to their positions at the end of the load step (a displacement history
-        // lands exactly; a velocity moves them by v·Δt), free particles held.
-        let zero_velocities = |p: &mut Particles<M>| {
-            for a in &mut p.alter[..p.n_owned] {
-                a.as_mut_slice()[n2..2 * n2].fill(0.0);
-            }
-        };
-        zero_velocities(&mut self.sim.particles);
-        for c in &self.sim.constraints {
-            c.set_drift_velocity(&mut self.sim.particles, t0, dt);
-        }
-        {
-            let sim = &mut self.sim;
-            for a in &mut sim.particles.alter[..n] {
-                sim.model.drift(a, dt);
-            }
-        }
-        zero_velocities(&mut self.sim.particles);
-        self.sim.time = t0 + dt;
-        self.sim.step += 1;
         let lambda: Vec<f64> = (0..n)
             .flat_map(|i| {
                 let g = self.sim.particles.gid[i] as usize;

@@ -2,57 +2,11 @@
 //! dynamic relaxation, in far fewer force evaluations, for PMB, LPS and micropolar; what it
 //! cannot do is refused by name.
 
+mod common;
+
+use common::bar_deck;
 use pdq::deck;
 use pdq::run::{run, RunOptions, Summary};
-
-/// A bar 40 × 6 × 6 mm held at x ≤ 3 mm and pulled by 10 N at x ≥ 37 mm in four load steps
-/// (the bar of tests/relaxation.rs), solved by `kind` to 10⁻⁹.
-fn bar_deck(model: &str, kind: &str) -> String {
-    let material = match model {
-        "micropolar" => "youngs_modulus = \"22.35 GPa\"\npoisson_ratio = 0.2\n",
-        "lps" => "bulk_modulus = \"14.9 GPa\"\npoisson_ratio = 0.3\n",
-        _ => "bulk_modulus = \"14.9 GPa\"\n",
-    };
-    format!(
-        r#"units = "SI"
-[model]
-name = "{model}"
-horizon = "3.015 mm"
-[lattice]
-spacing = "1 mm"
-[materials.rock]
-density = "2200 kg/m^3"
-{material}critical_stretch = 0.05
-[[geometry]]
-shape = "box"
-material = "rock"
-min = "0 0 0 mm"
-max = "40 6 6 mm"
-[time]
-duration = "1 ms"
-[solver]
-kind = "{kind}"
-load_steps = 4
-tolerance = 1e-9
-[[boundary]]
-name = "left"
-region = {{ shape = "slab", axis = "x", from = "0 mm", to = "3 mm" }}
-fixed = ["all"]
-[[load]]
-name = "pull"
-region = {{ shape = "slab", axis = "x", from = "37 mm", to = "40 mm" }}
-total_force = "10 0 0 N"
-history = {{ ramp = "1 ms" }}
-[[probe]]
-name = "tip"
-at = "39 3 3 mm"
-[output]
-progress = false
-history_every = 1
-final_state = true
-"#
-    )
-}
 
 /// Runs the bar; the summary, each load step's (load, reaction, tip displacement, residual)
 /// and the final positions.

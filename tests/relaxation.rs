@@ -3,60 +3,15 @@
 //! on one and on several procCubes, for PMB, LPS and micropolar; models it cannot relax are
 //! refused.
 
+mod common;
+
+use common::bar_deck;
 use pdq::deck;
 use pdq::decomposition::{Procs, Walls};
 use pdq::run::{run, RunOptions, Summary};
 
-/// A bar 40 × 6 × 6 mm held at x ≤ 3 mm and pulled by 10 N at x ≥ 37 mm (strain 2·10⁻⁵, so
-/// the geometric nonlinearity is of that order), in four load steps, relaxed to 10⁻⁹.
-fn bar_deck(model: &str) -> String {
-    let material = match model {
-        "micropolar" => "youngs_modulus = \"22.35 GPa\"\npoisson_ratio = 0.2\n",
-        "lps" => "bulk_modulus = \"14.9 GPa\"\npoisson_ratio = 0.3\n",
-        _ => "bulk_modulus = \"14.9 GPa\"\n",
-    };
-    format!(
-        r#"units = "SI"
-[model]
-name = "{model}"
-horizon = "3.015 mm"
-[lattice]
-spacing = "1 mm"
-[materials.rock]
-density = "2200 kg/m^3"
-{material}critical_stretch = 0.05
-[[geometry]]
-shape = "box"
-material = "rock"
-min = "0 0 0 mm"
-max = "40 6 6 mm"
-[time]
-duration = "1 ms"
-[solver]
-kind = "adr"
-load_steps = 4
-tolerance = 1e-9
-[[boundary]]
-name = "left"
-region = {{ shape = "slab", axis = "x", from = "0 mm", to = "3 mm" }}
-fixed = ["all"]
-[[load]]
-name = "pull"
-region = {{ shape = "slab", axis = "x", from = "37 mm", to = "40 mm" }}
-total_force = "10 0 0 N"
-history = {{ ramp = "1 ms" }}
-[[probe]]
-name = "tip"
-at = "39 3 3 mm"
-[output]
-progress = false
-history_every = 1
-"#
-    )
-}
-
 fn relax(model: &str, threads: usize, procs: [usize; 3]) -> (Summary, Vec<Vec<f64>>) {
-    let scene = deck::parse(&bar_deck(model), "bar.toml", "bar").unwrap();
+    let scene = deck::parse(&bar_deck(model, "adr"), "bar.toml", "bar").unwrap();
     static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let k = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!(
@@ -140,7 +95,7 @@ fn relaxation_gives_the_same_equilibrium_on_several_procubes() {
 
 #[test]
 fn relaxation_refuses_a_temperature_model() {
-    let text = bar_deck("pmb")
+    let text = bar_deck("pmb", "adr")
         .replace("name = \"pmb\"", "name = \"thermal\"")
         .replace(
             "bulk_modulus = \"14.9 GPa\"\n",
@@ -163,9 +118,9 @@ fn relaxation_refuses_a_temperature_model() {
 
 #[test]
 fn a_relaxation_restarted_between_load_steps_ends_bit_identical() {
-    let text = bar_deck("pmb").replace(
+    let text = bar_deck("pmb", "adr").replace(
         "history_every = 1",
-        "history_every = 1\ncheckpoint_every = 2\nfinal_state = true",
+        "history_every = 1\ncheckpoint_every = 2",
     );
     let scene = deck::parse(&text, "bar.toml", "bar").unwrap();
     let dir = |name: &str| {

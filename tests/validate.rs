@@ -107,3 +107,38 @@ history_every = 1
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// The sweep of the cantilever writes its table and plot, one row per point, each with a
+/// finite error; the PMB beam gets stiffer (smaller error) as the section gets more planes.
+#[test]
+fn the_sweep_reports_error_against_run_time() {
+    let dir = out("sweep");
+    let table = validate::sweep(
+        &dir,
+        &["pmb".to_string()],
+        &[3, 5],
+        &[3.0],
+        &["implicit".to_string()],
+    )
+    .unwrap();
+    let rows: Vec<&str> = table.lines().filter(|l| l.starts_with("| pmb")).collect();
+    assert_eq!(rows.len(), 2, "{table}");
+    let error = |row: &str| -> f64 { row.split('|').nth(6).unwrap().trim().parse().unwrap() };
+    let (coarse, fine) = (error(rows[0]), error(rows[1]));
+    assert!(coarse.is_finite() && fine.is_finite());
+    assert!(
+        fine.abs() < coarse.abs(),
+        "3 planes {coarse} %, 5 planes {fine} %"
+    );
+    assert!(dir.join("sweep.png").exists() && dir.join("sweep.md").exists());
+    let e = validate::sweep(
+        &dir,
+        &["pmb".to_string()],
+        &[4],
+        &[3.0],
+        &["implicit".to_string()],
+    )
+    .unwrap_err();
+    assert!(e.contains("odd"), "{e}");
+    let _ = std::fs::remove_dir_all(dir);
+}
