@@ -614,6 +614,8 @@ pub fn run(opts: &StressOptions) -> Result<String, String> {
     let wants = |s: &str| opts.sections.is_empty() || opts.sections.iter().any(|o| o == s);
     let threads = opts.threads.max(1);
     let mut out = String::new();
+    // What a stable engine must show; any of these fails the command (CI runs it).
+    let mut broken_expectations = Vec::new();
     if wants("dt") {
         let (n, steps, halvings) = if opts.quick {
             (8, 500, 6)
@@ -635,6 +637,14 @@ pub fn run(opts: &StressOptions) -> Result<String, String> {
         );
         for r in rows {
             let r = r?;
+            if r.lo < 1.0 {
+                broken_expectations.push(format!(
+                    "{} {}: unstable below the bound (stable only to {:.3} × the bound)",
+                    r.model,
+                    r.lattice.name(),
+                    r.lo
+                ));
+            }
             let ratio = if r.hi.is_finite() {
                 format!(
                     "{:.3} (stable {:.3}, unstable {:.3})",
@@ -709,6 +719,16 @@ pub fn run(opts: &StressOptions) -> Result<String, String> {
         );
         for r in rows {
             let r = r?;
+            if !r.finite || r.largest > 1.1 || r.fastest >= 0.5 {
+                broken_expectations.push(format!(
+                    "{} {}: finite {}, largest E/E0 {:.4}, fastest {:.3} spacings per step",
+                    r.model,
+                    r.case.name(),
+                    r.finite,
+                    r.largest,
+                    r.fastest
+                ));
+            }
             let _ = writeln!(
                 out,
                 "| {} | {} | {} | {} of {} | {:.4} | {:.4} | {} | {:.3} | {:.1} |",
@@ -725,6 +745,12 @@ pub fn run(opts: &StressOptions) -> Result<String, String> {
             );
         }
         out.push('\n');
+    }
+    if !broken_expectations.is_empty() {
+        return Err(format!(
+            "{out}stability expectations broken:\n{}",
+            broken_expectations.join("\n")
+        ));
     }
     Ok(out)
 }
