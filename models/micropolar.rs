@@ -23,6 +23,8 @@
 //! Solids break at s0 = √(5G0(1 − 2ν)/(3Eδ)) (axial energy only) or a given critical stretch;
 //! concrete (kind = "concrete") at its tensile and compressive stretches s_c < s < s_t.
 
+use crate::attributes::Attributes;
+use crate::lanes::{LaneForces, Real, F4, LANES};
 use crate::model::{check_options, BondGeom, MaterialKind, Model, ModelBuild, Side};
 use std::f64::consts::PI;
 
@@ -96,7 +98,7 @@ fn matrix(q: &[f64; 4]) -> [f64; 9] {
 
 /// a ⊗ b.
 #[inline(always)]
-fn product(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+fn product<T: Real>(a: &[T; 4], b: &[T; 4]) -> [T; 4] {
     [
         a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
         a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
@@ -108,11 +110,12 @@ fn product(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
 /// sin|φ| φ̂ and 1 − cos|φ| of the rotation φ taking orientation `qi` to `qj` (spatial frame):
 /// from q = q_j ⊗ q_i*, sin|φ| φ̂ = 2 q_w q_v and 1 − cos|φ| = 2|q_v|².
 #[inline(always)]
-fn relative(qi: &[f64; 4], qj: &[f64; 4]) -> ([f64; 3], f64) {
+fn relative<T: Real>(qi: &[T; 4], qj: &[T; 4]) -> ([T; 3], T) {
     let q = product(qj, &[qi[0], -qi[1], -qi[2], -qi[3]]);
+    let two = T::splat(2.0);
     (
-        [2.0 * q[0] * q[1], 2.0 * q[0] * q[2], 2.0 * q[0] * q[3]],
-        2.0 * (q[1] * q[1] + q[2] * q[2] + q[3] * q[3]),
+        [two * q[0] * q[1], two * q[0] * q[2], two * q[0] * q[3]],
+        two * (q[1] * q[1] + q[2] * q[2] + q[3] * q[3]),
     )
 }
 
@@ -157,43 +160,102 @@ fn quaternion(r: [f64; 3]) -> [f64; 4] {
     [c, k * r[0], k * r[1], k * r[2]]
 }
 
-impl Micropolar {
-    /// The bond's strain measures, scaled by L to save divisions: (y, |y|, 1/(L|y|), s, D, G)
-    /// with D = Q ξ of both ends as pairs per component, `d[k] = [D_i[k], D_j[k]]` (the two
-    /// ends' arithmetic is the same, so pairs map onto two-lane vector instructions), and
-    /// G = y − ½(D_i + D_j) = L g.
-    #[inline(always)]
-    #[allow(clippy::type_complexity)]
-    fn kinematics(
-        i: &Side<Self>,
-        j: &Side<Self>,
-        geom: &BondGeom,
-    ) -> ([f64; 3], f64, f64, f64, [[f64; 2]; 3], [f64; 3]) {
-        let (a, b) = (i.pos(), j.pos());
-        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
-        let l = geom.length;
-        // One division per bond: 1/L = r/(L r).
-        let inv_lr = 1.0 / (l * r);
-        let xi = [j.x0[0] - i.x0[0], j.x0[1] - i.x0[1], j.x0[2] - i.x0[2]];
-        let (ri, rj) = (&i.alter.frame, &j.alter.frame);
-        // Written out, not `[0, 1, 2].map`: `map` goes through a call the inliner may keep out
-        // of line in a long bond loop.
-        let row =
-            |m: &[f64; 9], k: usize| m[3 * k] * xi[0] + m[3 * k + 1] * xi[1] + m[3 * k + 2] * xi[2];
-        let d = [
-            [row(ri, 0), row(rj, 0)],
-            [row(ri, 1), row(rj, 1)],
-            [row(ri, 2), row(rj, 2)],
-        ];
-        let g = [
-            y[0] - 0.5 * (d[0][0] + d[0][1]),
-            y[1] - 0.5 * (d[1][0] + d[1][1]),
-            y[2] - 0.5 * (d[2][0] + d[2][1]),
-        ];
-        (y, r, inv_lr, (r - l) * r * inv_lr, d, g)
+/// A bond's strain measures, scaled by L to save divisions, for one bond (`T = f64`) or a lane
+/// group of four (`T = F4`): y, |y|, 1/(L|y|), s, D_i = Q_i ξ, D_j = Q_j ξ and
+/// G = y − ½(D_i + D_j) = L g.
+struct Kinematics<T> {
+    y: [T; 3],
+    r: T,
+    inv_lr: T,
+    s: T,
+    d_i: [T; 3],
+    d_j: [T; 3],
+    g: [T; 3],
+}
+
+/// The two ends of a bond as the law reads them: current and reference positions, frames.
+struct Ends<T> {
+    pos: [[T; 3]; 2],
+    x0: [[T; 3]; 2],
+    frame: [[T; 9]; 2],
+}
+
+#[inline(always)]
+fn kinematics<T: Real>(e: &Ends<T>, l: T) -> Kinematics<T> {
+    let ([a, b], [a0, b0]) = (e.pos, e.x0);
+    let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+    // One division per bond: 1/L = r/(L r).
+    let inv_lr = T::splat(1.0) / (l * r);
+    let xi = [b0[0] - a0[0], b0[1] - a0[1], b0[2] - a0[2]];
+    // Written out, not `[0, 1, 2].map`: `map` goes through a call the inliner may keep out of
+    // line in a long bond loop.
+    let turn = |m: &[T; 9]| {
+        [
+            m[0] * xi[0] + m[1] * xi[1] + m[2] * xi[2],
+            m[3] * xi[0] + m[4] * xi[1] + m[5] * xi[2],
+            m[6] * xi[0] + m[7] * xi[1] + m[8] * xi[2],
+        ]
+    };
+    let (d_i, d_j) = (turn(&e.frame[0]), turn(&e.frame[1]));
+    let half = T::splat(0.5);
+    let g = [
+        y[0] - half * (d_i[0] + d_j[0]),
+        y[1] - half * (d_i[1] + d_j[1]),
+        y[2] - half * (d_i[2] + d_j[2]),
+    ];
+    Kinematics {
+        y,
+        r,
+        inv_lr,
+        s: (r - l) * r * inv_lr,
+        d_i,
+        d_j,
+        g,
     }
 }
+
+/// Force on i and the two moments without the relative-rotation term, from c_n − c_s (`a`),
+/// c_s, L and v = β V_i V_j. With G = L g and D = L d: f = v[(c_n − c_s) s y/|y| + c_s G/L]
+/// and M_i = ½L c_s v d_i × g = (c_s v/(2L)) D_i × G; y/|y| = L y/(L|y|), 1/L = |y|/(L|y|).
+#[inline(always)]
+fn forces<T: Real>(k: &Kinematics<T>, a: T, cs: T, l: T, v: T) -> [[T; 3]; 3] {
+    let (y, g) = (k.y, k.g);
+    let axial = v * a * k.s * l * k.inv_lr;
+    let shear = v * cs * k.r * k.inv_lr;
+    let f = [
+        axial * y[0] + shear * g[0],
+        axial * y[1] + shear * g[1],
+        axial * y[2] + shear * g[2],
+    ];
+    let half = T::splat(0.5) * shear;
+    let hg = [half * g[0], half * g[1], half * g[2]];
+    let cross = |d: &[T; 3]| {
+        [
+            d[1] * hg[2] - d[2] * hg[1],
+            d[2] * hg[0] - d[0] * hg[2],
+            d[0] * hg[1] - d[1] * hg[0],
+        ]
+    };
+    [f, cross(&k.d_i), cross(&k.d_j)]
+}
+
+/// Adds the relative-rotation moments ±κ_φ v sin|φ| φ̂ to `[f, M_i, M_j]` (κ_φ ≠ 0 only).
+#[inline(always)]
+fn add_relative<T: Real>(kappa: T, v: T, qi: &[T; 4], qj: &[T; 4], fm: &mut [[T; 3]; 3]) {
+    let (sin_phi, _) = relative(qi, qj);
+    let k = kappa * v;
+    for c in 0..3 {
+        fm[1][c] = fm[1][c] + k * sin_phi[c];
+        fm[2][c] = fm[2][c] - k * sin_phi[c];
+    }
+}
+
+/// Offsets (in values) of fields of the particle record, for loading them four particles at a
+/// time.
+const POS: usize = std::mem::offset_of!(Motion6, pos) / 8;
+const ORIENTATION: usize = std::mem::offset_of!(Motion6, orientation) / 8;
+const FRAME: usize = std::mem::offset_of!(Motion6, frame) / 8;
 
 impl Model for Micropolar {
     const NAME: &'static str = "micropolar";
@@ -204,8 +266,9 @@ impl Model for Micropolar {
         "relative-rotation stiffness as a multiple of c_n*delta^2 (default 0; uncalibrated)",
     )];
 
-    // About 115 flops per bond: two bonds side by side fill the vector lanes (docs/performance.md).
-    const PAIRED_BONDS: bool = true;
+    // About 115 flops per bond: four bonds side by side fill the vector lanes
+    // (docs/performance.md).
+    const BOND_LANES: usize = LANES;
 
     type Alter = Motion6;
     type Fixed = ();
@@ -347,43 +410,24 @@ impl Model for Micropolar {
         geom: &BondGeom,
         _: &mut (),
     ) -> Option<(Force6, Force6)> {
-        let (y, r, inv_lr, s, d, g) = Self::kinematics(i, j, geom);
-        if s > law.tensile || s < law.compressive {
+        let ends = Ends {
+            pos: [i.pos(), j.pos()],
+            x0: [*i.x0, *j.x0],
+            frame: [i.alter.frame, j.alter.frame],
+        };
+        let k = kinematics(&ends, geom.length);
+        if k.s > law.tensile || k.s < law.compressive {
             return None;
         }
-        // With G = L g and D = L d: f = v[(c_n − c_s) s y/|y| + c_s G/L] and
-        // M_i = ½L c_s v d_i × g = (c_s v/(2L)) D_i × G.
         let v = geom.beta * i.volume * j.volume;
-        // y/|y| = L y/(L|y|) and 1/L = |y|/(L|y|).
-        let axial = v * law.a * s * geom.length * inv_lr;
-        let shear = v * law.cs * r * inv_lr;
-        let f = [
-            axial * y[0] + shear * g[0],
-            axial * y[1] + shear * g[1],
-            axial * y[2] + shear * g[2],
-        ];
-        let half = 0.5 * shear;
-        let hg = [half * g[0], half * g[1], half * g[2]];
-        // D × hG for both ends at once, component k from the pairs of components k+1, k+2.
-        let cross = |p: usize, q: usize| {
-            [
-                d[p][0] * hg[q] - d[q][0] * hg[p],
-                d[p][1] * hg[q] - d[q][1] * hg[p],
-            ]
-        };
-        let m = [cross(1, 2), cross(2, 0), cross(0, 1)];
-        let mut moment_i = [m[0][0], m[1][0], m[2][0]];
-        let mut moment_j = [m[0][1], m[1][1], m[2][1]];
+        let mut fm = forces(&k, law.a, law.cs, geom.length, v);
         // κ_φ = 0 (the default) skips the relative rotation; one law per pass keeps the branch
         // predictable.
         if law.kappa != 0.0 {
-            let (sin_phi, _) = relative(&i.alter.orientation, &j.alter.orientation);
-            let k = law.kappa * v;
-            for c in 0..3 {
-                moment_i[c] += k * sin_phi[c];
-                moment_j[c] -= k * sin_phi[c];
-            }
+            let (qi, qj) = (&i.alter.orientation, &j.alter.orientation);
+            add_relative(law.kappa, v, qi, qj, &mut fm);
         }
+        let [f, moment_i, moment_j] = fm;
         Some((
             Force6 {
                 force: f,
@@ -396,8 +440,90 @@ impl Model for Micropolar {
         ))
     }
 
+    /// Four bonds as the four lanes of `F4` values, through the same `kinematics`, `forces`
+    /// and `add_relative` as `pair`: the same bits, every operation on four bonds at once.
+    #[inline(always)]
+    fn pair_lanes(
+        &self,
+        law: [&Law; LANES],
+        i: &Side<Self>,
+        j: [&Side<Self>; LANES],
+        geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        let rows = [
+            j[0].alter.as_slice(),
+            j[1].alter.as_slice(),
+            j[2].alter.as_slice(),
+            j[3].alter.as_slice(),
+        ];
+        let own = |v: &[f64]| [F4::splat(v[0]), F4::splat(v[1]), F4::splat(v[2])];
+        let [p0, p1, p2, _] = F4::columns::<POS>(rows);
+        let [r0, r1, r2, r3] = F4::columns::<FRAME>(rows);
+        let [r4, r5, r6, r7] = F4::columns::<{ FRAME + 4 }>(rows);
+        let r8 = F4::gather(|l| rows[l][FRAME + 8]);
+        let fi = &i.alter.frame;
+        let ends = Ends {
+            pos: [own(&i.alter.pos), [p0, p1, p2]],
+            x0: [
+                own(i.x0),
+                [
+                    F4::gather(|l| j[l].x0[0]),
+                    F4::gather(|l| j[l].x0[1]),
+                    F4::gather(|l| j[l].x0[2]),
+                ],
+            ],
+            frame: [
+                [
+                    F4::splat(fi[0]),
+                    F4::splat(fi[1]),
+                    F4::splat(fi[2]),
+                    F4::splat(fi[3]),
+                    F4::splat(fi[4]),
+                    F4::splat(fi[5]),
+                    F4::splat(fi[6]),
+                    F4::splat(fi[7]),
+                    F4::splat(fi[8]),
+                ],
+                [r0, r1, r2, r3, r4, r5, r6, r7, r8],
+            ],
+        };
+        let length = F4::gather(|l| geom[l].length);
+        let k = kinematics(&ends, length);
+        let tensile = F4::gather(|l| law[l].tensile);
+        if k.s.any_outside(F4::gather(|l| law[l].compressive), tensile) {
+            return None;
+        }
+        let v = F4::gather(|l| geom[l].beta * i.volume * j[l].volume);
+        let (a, cs) = (F4::gather(|l| law[l].a), F4::gather(|l| law[l].cs));
+        let mut fm = forces(&k, a, cs, length, v);
+        // κ_φ of every law is the option times c_n δ², so this is the same test as `pair`'s.
+        if self.kappa != 0.0 {
+            let q = &i.alter.orientation;
+            let qi = [
+                F4::splat(q[0]),
+                F4::splat(q[1]),
+                F4::splat(q[2]),
+                F4::splat(q[3]),
+            ];
+            let qj = F4::columns::<ORIENTATION>(rows);
+            add_relative(F4::gather(|l| law[l].kappa), v, &qi, &qj, &mut fm);
+        }
+        let [f, m_i, m_j] = fm;
+        let zero = F4::splat(0.0);
+        Some(LaneForces {
+            i: [f[0], f[1], f[2], m_i[0], m_i[1], m_i[2], zero, zero],
+            j: [-f[0], -f[1], -f[2], m_j[0], m_j[1], m_j[2], zero, zero],
+        })
+    }
+
     fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {
-        let (_, _, _, s, _, big_g) = Self::kinematics(i, j, geom);
+        let ends = Ends {
+            pos: [i.pos(), j.pos()],
+            x0: [*i.x0, *j.x0],
+            frame: [i.alter.frame, j.alter.frame],
+        };
+        let k = kinematics(&ends, geom.length);
+        let (s, big_g) = (k.s, k.g);
         let (_, one_minus_cos) = relative(&i.alter.orientation, &j.alter.orientation);
         let l2 = geom.length * geom.length;
         let g2 = (big_g[0] * big_g[0] + big_g[1] * big_g[1] + big_g[2] * big_g[2]) / l2;
@@ -416,6 +542,128 @@ impl Model for Micropolar {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::{Material, OptionValue};
+
+    fn model(kappa: f64, materials: &[Material]) -> Micropolar {
+        let options = [("kappa".to_string(), OptionValue::Number(kappa))];
+        Micropolar::build(&ModelBuild {
+            materials,
+            horizon: 3.015e-3,
+            spacing: 1e-3,
+            options: &options,
+        })
+        .unwrap()
+    }
+
+    fn solid(name: &str, e: f64, nu: f64, s0: f64) -> Material {
+        let mut m = Material::new(name, MaterialKind::Solid, 2400.0);
+        m.youngs_modulus = Some(e);
+        m.poisson_ratio = Some(nu);
+        m.critical_stretch = Some(s0);
+        m
+    }
+
+    /// A particle moved and turned by a deterministic pseudo-random amount.
+    fn particle(seed: u64, x0: [f64; 3], scale: f64) -> Motion6 {
+        let mut x = seed.wrapping_mul(0x9e3779b97f4a7c15) | 1;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut a = Motion6::default();
+        for (p, x) in a.pos.iter_mut().zip(x0) {
+            *p = x + scale * 1e-4 * next();
+        }
+        let r = [scale * next(), scale * next(), scale * next()];
+        a.orientation = quaternion(r);
+        a.frame = matrix(&a.orientation);
+        a
+    }
+
+    /// `pair_lanes` gives `pair`'s forces bit for bit, with and without κ_φ, for two materials,
+    /// and `None` when one lane breaks.
+    #[test]
+    fn lanes_give_the_single_bond_forces_bit_for_bit() {
+        let materials = [solid("a", 30e9, 0.2, 0.01), solid("b", 200e9, 0.1, 0.02)];
+        for kappa in [0.0, 0.3] {
+            let m = model(kappa, &materials);
+            let x0 = [
+                [0.0, 0.0, 0.0],
+                [1e-3, 0.0, 0.0],
+                [0.0, 2e-3, 1e-3],
+                [1e-3, 1e-3, 1e-3],
+                [-2e-3, 1e-3, 0.0],
+            ];
+            let alter: Vec<Motion6> = (0..5).map(|p| particle(p as u64 + 7, x0[p], 0.2)).collect();
+            let material = [0u16, 1, 0, 1, 1];
+            let side = |p: usize| Side::<Micropolar> {
+                x0: &x0[p],
+                volume: 1e-9 * (1.0 + p as f64 / 10.0),
+                material: material[p],
+                alter: &alter[p],
+                fixed: &(),
+                state: &(),
+            };
+            let i = side(0);
+            let js = [side(1), side(2), side(3), side(4)];
+            let geoms: Vec<BondGeom> = (1..5)
+                .map(|p| {
+                    let d = [
+                        x0[p][0] - x0[0][0],
+                        x0[p][1] - x0[0][1],
+                        x0[p][2] - x0[0][2],
+                    ];
+                    BondGeom {
+                        length: (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(),
+                        beta: 1.0 - p as f64 / 20.0,
+                    }
+                })
+                .collect();
+            let laws: Vec<Law> = js.iter().map(|j| m.law(0, j.material)).collect();
+            let lanes = m
+                .pair_lanes(
+                    [&laws[0], &laws[1], &laws[2], &laws[3]],
+                    &i,
+                    [&js[0], &js[1], &js[2], &js[3]],
+                    [&geoms[0], &geoms[1], &geoms[2], &geoms[3]],
+                )
+                .expect("no lane breaks");
+            for l in 0..LANES {
+                let (a, b) = m.pair(&laws[l], &i, &js[l], &geoms[l], &mut ()).unwrap();
+                for (c, (x, y)) in a.as_slice().iter().zip(b.as_slice()).enumerate() {
+                    assert_eq!(
+                        lanes.i[c].lane(l).to_bits(),
+                        x.to_bits(),
+                        "kappa {kappa} lane {l} i {c}"
+                    );
+                    assert_eq!(
+                        lanes.j[c].lane(l).to_bits(),
+                        y.to_bits(),
+                        "kappa {kappa} lane {l} j {c}"
+                    );
+                }
+                assert!(a.moment.iter().any(|&v| v != 0.0));
+            }
+            // Lane 2 stretched past its critical stretch: the group is refused.
+            let mut far = alter[3];
+            far.pos[0] += 1e-4;
+            let j2 = Side::<Micropolar> {
+                alter: &far,
+                ..side(3)
+            };
+            assert!(m.pair(&laws[2], &i, &j2, &geoms[2], &mut ()).is_none());
+            assert!(m
+                .pair_lanes(
+                    [&laws[0], &laws[1], &laws[2], &laws[3]],
+                    &i,
+                    [&js[0], &js[1], &j2, &js[3]],
+                    [&geoms[0], &geoms[1], &geoms[2], &geoms[3]],
+                )
+                .is_none());
+        }
+    }
 
     #[test]
     fn quaternions_round_trip() {

@@ -6,6 +6,7 @@
 
 use crate::attributes::{add_assign, Attributes};
 use crate::bonds::BondList;
+use crate::lanes::{LaneForces, F4, LANES, MAX_COMPONENTS};
 use crate::model::{BondGeom, Model, Side};
 use crate::particles::Particles;
 
@@ -177,6 +178,19 @@ trait BondVisit<M: Model, T> {
         geom: &BondGeom,
         bond: &mut M::Bond,
     ) -> Option<(T, T)>;
+
+    /// Four intact bonds of particle `i` at once (see [`Model::pair_lanes`]), or `None`: one
+    /// by one.
+    #[inline(always)]
+    fn visit_lanes(
+        &self,
+        _law: [&M::Law; LANES],
+        _i: &Side<M>,
+        _j: [&Side<M>; LANES],
+        _geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        None
+    }
 }
 
 /// The state pass: each bond's contributions to its ends' states; it never breaks a bond.
@@ -210,6 +224,17 @@ impl<M: Model> BondVisit<M, M::Force> for PairOfBond<'_, M> {
         bond: &mut M::Bond,
     ) -> Option<(M::Force, M::Force)> {
         self.0.pair(law, i, j, geom, bond)
+    }
+
+    #[inline(always)]
+    fn visit_lanes(
+        &self,
+        law: [&M::Law; LANES],
+        i: &Side<M>,
+        j: [&Side<M>; LANES],
+        geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        self.0.pair_lanes(law, i, j, geom)
     }
 }
 
@@ -274,6 +299,10 @@ where
             && (bonds_max_partner < n || offsets.last() == Some(&0)),
         "bond list does not match the particle store"
     );
+    assert!(
+        M::BOND_LANES == 1 || <M::Bond as Attributes>::LEN == 0,
+        "a model with lanes keeps no bond history"
+    );
     let mut newly_broken = 0;
     for i in 0..n_owned {
         // Local copies: the compiler cannot tell that the stores into `out` below leave
@@ -309,50 +338,66 @@ where
         let len = partner.len();
         let mut k = 0;
         while k < len {
-            // Two intact bonds at once if the model asks (`Model::PAIRED_BONDS`): two copies of
-            // the same arithmetic in one block, which the compiler pairs into vector
-            // instructions, one lane per bond. The sums are made in bond order either way.
-            let two = M::PAIRED_BONDS && k + 1 < len && (!DAMAGE || (!broken[k] && !broken[k + 1]));
-            let n = if two { 2 } else { 1 };
-            if DAMAGE && !two && broken[k] {
+            // Bonds k..end go one by one.
+            let mut end = k + 1;
+            // Four intact bonds at once if the model asks (`Model::BOND_LANES`): the next four
+            // intact ones, as one lane group. The sums are made in bond order either way, and
+            // broken bonds add nothing, so skipping them changes nothing. If one of the four
+            // breaks, the model says so and they go one by one.
+            if M::BOND_LANES == LANES {
+                let mut at = [0usize; LANES];
+                let (mut n, mut next) = (0, k);
+                while n < LANES && next < len {
+                    if !DAMAGE || !broken[next] {
+                        at[n] = next;
+                        n += 1;
+                    }
+                    next += 1;
+                }
+                if n == LANES {
+                    let js = at.map(|b| partner[b] as usize);
+                    let sides = [side(js[0]), side(js[1]), side(js[2]), side(js[3])];
+                    let laws = [
+                        law_of(side_i.material, sides[0].material),
+                        law_of(side_i.material, sides[1].material),
+                        law_of(side_i.material, sides[2].material),
+                        law_of(side_i.material, sides[3].material),
+                    ];
+                    if let Some(f) = visit.visit_lanes(
+                        [&laws[0], &laws[1], &laws[2], &laws[3]],
+                        &side_i,
+                        [&sides[0], &sides[1], &sides[2], &sides[3]],
+                        [&geom[at[0]], &geom[at[1]], &geom[at[2]], &geom[at[3]]],
+                    ) {
+                        // SAFETY: partners are in bounds, as above.
+                        unsafe { add_lanes(&mut oi, out, js, &f) };
+                        k = next;
+                        continue;
+                    }
+                    end = next;
+                }
+            }
+            while k < end {
+                if !(DAMAGE && broken[k]) {
+                    let j = partner[k] as usize;
+                    let sj = side(j);
+                    let r = visit.visit(
+                        &law_of(side_i.material, sj.material),
+                        &side_i,
+                        &sj,
+                        &geom[k],
+                        &mut history[k],
+                    );
+                    // SAFETY: partners are in bounds, as above.
+                    newly_broken += add_or_break::<T, DAMAGE>(
+                        r,
+                        &mut oi,
+                        unsafe { out.get_unchecked_mut(j) },
+                        &mut broken[k],
+                    );
+                }
                 k += 1;
-                continue;
             }
-            let (h1, h2) = history[k..].split_at_mut(1);
-            let j1 = partner[k] as usize;
-            let s1 = side(j1);
-            let r1 = visit.visit(
-                &law_of(side_i.material, s1.material),
-                &side_i,
-                &s1,
-                &geom[k],
-                &mut h1[0],
-            );
-            let r2 = two.then(|| {
-                let j2 = partner[k + 1] as usize;
-                let s2 = side(j2);
-                let law = law_of(side_i.material, s2.material);
-                (
-                    j2,
-                    visit.visit(&law, &side_i, &s2, &geom[k + 1], &mut h2[0]),
-                )
-            });
-            // SAFETY (both): partners are in bounds, as above.
-            newly_broken += add_or_break::<T, DAMAGE>(
-                r1,
-                &mut oi,
-                unsafe { out.get_unchecked_mut(j1) },
-                &mut broken[k],
-            );
-            if let Some((j2, r2)) = r2 {
-                newly_broken += add_or_break::<T, DAMAGE>(
-                    r2,
-                    &mut oi,
-                    unsafe { out.get_unchecked_mut(j2) },
-                    &mut broken[k + 1],
-                );
-            }
-            k += n;
         }
         add_assign(&mut out[i], &oi);
     }
@@ -379,6 +424,40 @@ fn add_or_break<T: Attributes, const DAMAGE: bool>(
             1
         }
         None => 0,
+    }
+}
+
+/// Adds a lane group's forces: lane by lane (bond order) to the owner's sum `oi`, and lane l
+/// to partner `js[l]`. Each record is handled four components at a time: the four bonds'
+/// components are turned into one vector per bond, then added as vectors, which makes the
+/// same sums as adding value by value.
+///
+/// # Safety
+/// Every `js[l]` is below `out.len()`.
+#[inline(always)]
+unsafe fn add_lanes<T: Attributes>(oi: &mut T, out: &mut [T], js: [usize; LANES], f: &LaneForces) {
+    let n = T::LEN;
+    assert!(
+        n <= MAX_COMPONENTS,
+        "a model with lanes has at most 8 force components"
+    );
+    let mut c = 0;
+    while c < n {
+        let m = (n - c).min(LANES);
+        let block = |v: &[F4; MAX_COMPONENTS]| F4::transpose([v[c], v[c + 1], v[c + 2], v[c + 3]]);
+        let (ti, tj) = (block(&f.i), block(&f.j));
+        let own = &mut oi.as_mut_slice()[c..c + m];
+        let mut sum = F4::load_partial(own);
+        for t in ti {
+            sum = sum + t;
+        }
+        sum.store_partial(own);
+        for (l, t) in tj.into_iter().enumerate() {
+            // SAFETY: the caller keeps js[l] in bounds.
+            let o = &mut unsafe { out.get_unchecked_mut(js[l]) }.as_mut_slice()[c..c + m];
+            (F4::load_partial(o) + t).store_partial(o);
+        }
+        c += LANES;
     }
 }
 

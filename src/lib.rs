@@ -20,6 +20,7 @@ pub mod decomposition;
 pub mod forces;
 pub mod geometry;
 pub mod implicit;
+pub mod lanes;
 pub mod model;
 #[path = "../models/mod.rs"]
 pub mod models;

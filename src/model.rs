@@ -5,6 +5,7 @@
 //! `M: Model`, so each model gets its own monomorphized step with no dynamic dispatch per bond.
 
 use crate::attributes::Attributes;
+use crate::lanes::{LaneForces, LANES};
 
 /// What a material is made of, as far as a model needs to know to pick a bond law.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -249,11 +250,14 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     const FIRST_ORDER: usize = 0;
     /// Whether [`Model::bond_fixed`] adds bond sums to the fixed data (LPS weighted volume).
     const FIXED_FROM_BONDS: bool = false;
-    /// Whether the bond loops hand the model two intact bonds of a particle back to back, so
-    /// that the compiler can run them as the two lanes of vector instructions. Pays for a law
-    /// with much arithmetic per bond (micropolar: about 25 % faster); a short law (PMB) runs a
-    /// few per cent slower with it. Results are the same either way (sums in bond order).
-    const PAIRED_BONDS: bool = false;
+    /// Whether the bond loops hand the model four intact bonds of a particle at a time
+    /// ([`Model::pair_lanes`], [`crate::lanes`]): 1 (one bond per call) or
+    /// [`crate::lanes::LANES`]. Pays for a law with much arithmetic per bond written generic
+    /// over [`crate::lanes::Real`] (micropolar); a short law (PMB) gains nothing from it.
+    /// Results are the same either way (sums in bond order, no fused operations). Only for
+    /// models without bond history (`Bond` = `()`) and with at most
+    /// [`crate::lanes::MAX_COMPONENTS`] generalized forces.
+    const BOND_LANES: usize = 1;
 
     /// Changes during a run: generalized coordinates, then their velocities, then extras.
     type Alter: Attributes;
@@ -366,6 +370,21 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
         geom: &BondGeom,
         bond: &mut Self::Bond,
     ) -> Option<(Self::Force, Self::Force)>;
+
+    /// [`Model::pair`] of four intact bonds of particle `i` at once (lane `l`: partner `j[l]`,
+    /// law `law[l]`), for models with `BOND_LANES` = 4, which keep no bond history. `None`
+    /// when any of the four breaks now: the engine then calls `pair` on each. The forces come
+    /// component by component ([`crate::lanes::LaneForces`]) and must be those of `pair` bit
+    /// for bit.
+    fn pair_lanes(
+        &self,
+        _law: [&Self::Law; LANES],
+        _i: &Side<Self>,
+        _j: [&Side<Self>; LANES],
+        _geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        None
+    }
 
     /// Elastic energy stored in an intact bond (whole bond, both volumes included); with
     /// [`Model::particle_energy`] it makes the strain energy.
