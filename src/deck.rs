@@ -220,6 +220,7 @@ struct TimeSection {
     safety_factor: Option<f64>,
     force_dt: Option<bool>,
     integrator: Option<String>,
+    stop_at_broken_bonds: Option<i64>,
 }
 
 #[derive(Deserialize)]
@@ -332,6 +333,9 @@ pub struct TimeSpec {
     pub safety_factor: f64,
     pub force_dt: bool,
     pub integrator: Integrator,
+    /// End the run after the first step (load step) at which at least this many bonds have
+    /// broken; 0 = run to the end.
+    pub stop_at_broken_bonds: u64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -764,6 +768,16 @@ impl Converter {
         if dt.is_some() && t.safety_factor.is_some() {
             return self.err(time_line, "[time] give 'dt' or 'safety_factor', not both");
         }
+        let stop_at_broken_bonds = match t.stop_at_broken_bonds {
+            None => 0,
+            Some(n) if n >= 1 => n as u64,
+            Some(n) => {
+                return self.err(
+                    time_line,
+                    format!("[time] stop_at_broken_bonds must be a count >= 1 (got {n}); leave it out to run to the end"),
+                )
+            }
+        };
         let integrator = match t.integrator.as_deref().unwrap_or("verlet") {
             "verlet" | "velocity-verlet" => Integrator::VelocityVerlet,
             "euler" | "semi-implicit-euler" => Integrator::SemiImplicitEuler,
@@ -997,6 +1011,7 @@ impl Converter {
                 safety_factor,
                 force_dt: t.force_dt.unwrap_or(false),
                 integrator,
+                stop_at_broken_bonds,
             },
             boundaries,
             loads,

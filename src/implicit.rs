@@ -399,12 +399,15 @@ impl<M: Model> Cube<M> {
 
     /// One load step of the implicit solve: supports and loads move to `sim.time + sim.dt`,
     /// then Newton iterations with the (re)assembled tangent until the residual force is below
-    /// `tolerance` × (applied forces and reactions), as relaxation measures it.
+    /// `tolerance` × (applied forces and reactions), as relaxation measures it. With
+    /// `stop_broken` > 0 the iterations end, unconverged, once that many bonds have broken:
+    /// the run ends there (`[time] stop_at_broken_bonds`), so a new tangent would be wasted.
     pub fn implicit_step(
         &mut self,
         tangent: &mut Option<Tangent>,
         tolerance: f64,
         max_iterations: u64,
+        stop_broken: u64,
     ) -> Result<Relaxed, String> {
         let n2 = second_order::<M>();
         let n = self.sim.particles.n_owned;
@@ -433,7 +436,10 @@ impl<M: Model> Cube<M> {
             let scale = sums[1..].iter().map(|x| x * x).sum::<f64>().sqrt();
             residual = sums[0].sqrt() / scale.max(f64::MIN_POSITIVE);
             self.sim.timing.lap(Phase::Integration, t);
-            if residual <= tolerance || newton >= max_iterations {
+            if residual <= tolerance
+                || newton >= max_iterations
+                || (stop_broken > 0 && self.broken_count() as u64 >= stop_broken)
+            {
                 break;
             }
             let last_residual = std::mem::replace(&mut previous, residual);

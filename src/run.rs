@@ -48,6 +48,8 @@ pub struct Summary {
     pub force_evaluations: u64,
     /// Under relaxation: load steps that reached the tolerance within `max_iterations`.
     pub converged_steps: u64,
+    /// The run ended before its last step because `[time] stop_at_broken_bonds` was reached.
+    pub stopped_at_broken: bool,
 }
 
 /// Options the command line may set over the deck.
@@ -360,6 +362,8 @@ struct Plan {
     quiet: bool,
     final_state: bool,
     shuffle_every: u64,
+    /// `[time] stop_at_broken_bonds` (0 = off).
+    stop_at_broken: u64,
     n_probes: usize,
     layout: String,
     /// The step the loop starts from: 0, or the step of the checkpoint it resumes.
@@ -455,6 +459,7 @@ fn drive<M: Model>(
     let wall = Instant::now();
     let mut broken = 0usize;
     let mut shuffles = 0u64;
+    let mut stopped_at_broken = false;
     for step in first..=plan.steps {
         if step > first {
             let r = match &plan.relaxation {
@@ -471,7 +476,12 @@ fn drive<M: Model>(
                 Some(QuasiStatic::Implicit {
                     tolerance,
                     max_iterations,
-                }) => Some(cube.implicit_step(&mut tangent, *tolerance, *max_iterations)?),
+                }) => Some(cube.implicit_step(
+                    &mut tangent,
+                    *tolerance,
+                    *max_iterations,
+                    plan.stop_at_broken,
+                )?),
             };
             if let Some(r) = r {
                 evaluations += r.iterations;
@@ -487,7 +497,14 @@ fn drive<M: Model>(
                 cube.sim.timing.lap(Phase::Communication, t);
             }
         }
-        let last = step == plan.steps;
+        // Enough bonds broken ends the run here, as if this were the last step.
+        let halted = plan.stop_at_broken > 0 && step > first && {
+            let mut n = [cube.broken_count() as f64];
+            Team::new(cube.sim.exchange.transport()).reduce(&mut n, Reduce::Sum);
+            n[0] >= plan.stop_at_broken as f64
+        };
+        stopped_at_broken |= halted;
+        let last = step == plan.steps || halted;
         // A restarted run has the row and frame of its first step from before.
         let again = first > 0 && step == first;
         let want_row = (step % plan.every == 0 || last) && !again;
@@ -570,6 +587,9 @@ fn drive<M: Model>(
                 );
                 break;
             }
+        }
+        if halted {
+            break;
         }
     }
     let steps_done = cube.sim.step;
@@ -697,6 +717,7 @@ fn drive<M: Model>(
         first_step: first,
         force_evaluations: evaluations,
         converged_steps: converged,
+        stopped_at_broken,
     }))
 }
 
@@ -859,6 +880,7 @@ fn run_setup<M: Model>(
         quiet: opts.quiet,
         final_state: scene.output.final_state,
         shuffle_every: scene.parallel.shuffle_every,
+        stop_at_broken: scene.time.stop_at_broken_bonds,
         n_probes: setup.probes.len(),
         layout: layout.describe(),
         first_step: resume.map_or(0, |c| c.step),
@@ -1013,6 +1035,12 @@ fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
     }
     if opts.quiet {
         return;
+    }
+    if summary.stopped_at_broken {
+        eprintln!(
+            "stopped    at step {}: {} broken bonds reached [time] stop_at_broken_bonds",
+            summary.steps, summary.broken
+        );
     }
     eprintln!(
         "done       {} steps in {:.2} s; {} broken bonds",

@@ -45,6 +45,8 @@ pub struct Case {
     pub unit: &'static str,
     pub kind: Kind,
     pub reference: f64,
+    /// The thesis's own result, a second reference where the case is one of its problems.
+    pub thesis: Option<f64>,
     /// Where the reference comes from.
     pub formula: String,
     pub tolerance_percent: f64,
@@ -62,6 +64,7 @@ pub struct Outcome {
     pub kind: Kind,
     pub measured: f64,
     pub reference: f64,
+    pub thesis: Option<f64>,
     pub formula: String,
     pub error_percent: f64,
     pub tolerance_percent: f64,
@@ -254,6 +257,7 @@ at = "{tip_x} {mid} {mid} m"
         unit: "m",
         kind: Kind::Elastic,
         reference: bending + shear,
+        thesis: None,
         formula: format!(
             "Timoshenko PL³/3EI + PL/κGA, κ = 5/6; L = {span:.3} m, {}",
             beam.describe()
@@ -330,6 +334,7 @@ at = "{right_x} {mid} {mid} m"
         unit: "m",
         kind: Kind::Elastic,
         reference: bending + shear,
+        thesis: None,
         formula: format!(
             "5wL⁴/384EI + wL²/8κGA, κ = 5/6; L = {span:.3} m between the support lines, w = {w:.1} N/m, {}",
             beam.describe()
@@ -401,11 +406,262 @@ fn axis_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
     Ok(line)
 }
 
+/// The thesis's plain concrete beams (problems 4.1 and 4.3, THEORY.md §8): its concrete (E =
+/// 3605 ksi, ν = ¼, s_t = 1.387e-4, s_c = −1.1e-3, f'c = 4000 psi), 200 or 250 × 30 × 50 in,
+/// on the thesis's 1 in lattice (`--full`) or a 2.5 in one (`--quick`), m = 3, the energy
+/// surface correction. As in the thesis, the load is ramped in an explicit dynamic run; the
+/// run stops when the crack has run, i.e. when as many bonds have broken as cross a quarter of
+/// the section, and the load at that step is the measured strength. The first bonds break
+/// earlier, at the supports' corners (validation/README.md), and are not the beam's cracking.
+struct ConcreteBeam {
+    dx: f64,
+    length: f64,
+}
+
+/// Section of the thesis's beams: 30 in wide (y), 50 in deep (z).
+const CONCRETE_WIDTH: f64 = 30.0;
+const CONCRETE_DEPTH: f64 = 50.0;
+
+impl ConcreteBeam {
+    fn new(level: Level, length: f64) -> ConcreteBeam {
+        // 2.5 in divides 200, 250, 30 and 50 in.
+        let dx = match level {
+            Level::Quick => 2.5,
+            Level::Full => 1.0,
+        };
+        ConcreteBeam { dx, length }
+    }
+
+    /// f_r = 7.5√f'c with f'c = 4000 psi.
+    fn rupture_modulus() -> f64 {
+        7.5 * 4000f64.sqrt()
+    }
+
+    /// I/c of the section.
+    fn section_modulus() -> f64 {
+        CONCRETE_WIDTH * CONCRETE_DEPTH.powi(3) / 12.0 / (CONCRETE_DEPTH / 2.0)
+    }
+
+    /// Bonds crossing a quarter of the section: a plane cuts π m⁴/4 bonds per dx² of a simple
+    /// cubic lattice with horizon m dx (Σ ξ_x/dx over the half family with ξ_x > 0).
+    fn crack_bonds(&self) -> u64 {
+        let per_area = std::f64::consts::PI * 3f64.powi(4) / 4.0;
+        (per_area * CONCRETE_WIDTH * CONCRETE_DEPTH / (4.0 * self.dx * self.dx)).ceil() as u64
+    }
+
+    /// The deck through the model, material, box, time and output; the caller adds the
+    /// supports, the load (named `load`, with [`ConcreteBeam::ramp`]) and a probe `tip`.
+    fn deck_head(&self, title: &str, ramp_time: f64) -> String {
+        let (dx, length) = (self.dx, self.length);
+        let stop = self.crack_bonds();
+        format!(
+            r#"title = "validation: plain concrete {title} (thesis), {dx} in lattice"
+units = "in-lbf-s"
+[model]
+name = "concrete"
+m = 3
+surface_correction = "energy"
+[lattice]
+spacing = "{dx} in"
+[materials.concrete]
+kind = "concrete"
+density = "145 lb/ft^3"
+youngs_modulus = "3605 ksi"
+poisson_ratio = 0.25
+tensile_stretch = 1.387e-4
+compressive_stretch = -1.1e-3
+compressive_strength = "4000 psi"
+[[geometry]]
+shape = "box"
+material = "concrete"
+min = "0 0 0 in"
+max = "{length} {CONCRETE_WIDTH} {CONCRETE_DEPTH} in"
+[time]
+duration = "{ramp_time} s"
+stop_at_broken_bonds = {stop}
+[output]
+progress = false
+history_every = 20
+frames_every = 100000000
+"#
+        )
+    }
+
+    /// The load history: from 0 to 1.3 × the reference over `t` seconds, starting with zero
+    /// slope (a quarter cosine over the first fifth, then straight on with the same slope), so
+    /// that the ramp leaves little vibration in the beam.
+    fn ramp(t: f64) -> String {
+        let t1 = 0.2 * t;
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        // f = a(1 − cos(π t'/2 t1)) to t1, then a + a π/(2 t1)(t' − t1); f(t) = 1.3.
+        let a = 1.3 / (1.0 + half_pi * (t - t1) / t1);
+        let mut points: Vec<String> = (0..=12)
+            .map(|k| {
+                let tk = t1 * k as f64 / 12.0;
+                let f = a * (1.0 - (half_pi * tk / t1).cos());
+                format!("[\"{tk:.6e} s\", {f:.6e}]")
+            })
+            .collect();
+        points.push(format!("[\"{t:.6e} s\", 1.3]"));
+        format!("history = {{ table = [{}] }}", points.join(", "))
+    }
+}
+
+/// The applied load (history column `load_load`) at the step where the run stopped on its
+/// broken-bond count (`[time] stop_at_broken_bonds`).
+fn failure_load(summary: &Summary, dir: &Path) -> Result<f64, String> {
+    if !summary.stopped_at_broken {
+        return Err(format!(
+            "the beam did not fail within the ramp (to 1.3 × the reference): {} broken bonds at the end",
+            summary.broken
+        ));
+    }
+    last_of(dir, "load_load")
+}
+
+/// (deflection at the probe named `tip`, applied load) over the history rows.
+fn load_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
+    let (header, rows) = read_history(dir)?;
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| format!("history.csv has no column '{name}'"))
+    };
+    let (load, uz) = (col("load_load")?, col("tip_uz")?);
+    Ok(rows.iter().map(|r| (-r[uz], r[load])).collect())
+}
+
+/// Thesis problem 4.1: plain concrete cantilever, 200 × 30 × 50 in, clamped over its first
+/// three lattice planes, a downward end load on its last two; first cracking against beam
+/// theory, P = f_r (I/c)/L with L from the clamp face to the load's centre.
+fn concrete_cantilever(level: Level) -> Case {
+    let beam = ConcreteBeam::new(level, 200.0);
+    let dx = beam.dx;
+    let arm = (beam.length - dx) - 3.0 * dx;
+    let reference = ConcreteBeam::rupture_modulus() * ConcreteBeam::section_modulus() / arm;
+    let e = 3.605e6;
+    let inertia = CONCRETE_WIDTH * CONCRETE_DEPTH.powi(3) / 12.0;
+    let elastic_tip = reference * arm.powi(3) / (3.0 * e * inertia);
+    let deck = format!(
+        r#"{head}[[boundary]]
+name = "clamp"
+region = {{ shape = "slab", axis = "x", from = "0 in", to = "{clamp_to} in" }}
+fixed = ["all"]
+[[load]]
+name = "load"
+region = {{ shape = "slab", axis = "x", from = "{load_from} in", to = "{length} in" }}
+total_force = "0 0 -{reference} lbf"
+{ramp}
+[[probe]]
+name = "tip"
+at = "{length} {y} {z} in"
+"#,
+        head = beam.deck_head("cantilever, end load", 0.3),
+        ramp = ConcreteBeam::ramp(0.3),
+        clamp_to = 3.0 * dx,
+        load_from = beam.length - 2.0 * dx,
+        length = beam.length,
+        y = CONCRETE_WIDTH / 2.0,
+        z = CONCRETE_DEPTH / 2.0,
+    );
+    Case {
+        name: "concrete_cantilever".into(),
+        quantity: "strength (load when the crack has run)".into(),
+        unit: "lbf",
+        kind: Kind::Strength,
+        reference,
+        thesis: Some(30_000.0),
+        formula: format!(
+            "beam theory P = f_r·(I/c)/L, f_r = 7.5√f'c = {:.1} psi (f'c = 4000 psi), I/c = {:.0} in³, L = {arm} in (clamp face to the load's centre); thesis 4.1: \"approaches 30 kips\" (its formula, with L = 200 in: 29.6 kips)",
+            ConcreteBeam::rupture_modulus(),
+            ConcreteBeam::section_modulus()
+        ),
+        tolerance_percent: 15.0,
+        deck,
+        extract: failure_load,
+        plot: Some(Plot {
+            x_label: "tip deflection (in)".into(),
+            y_label: "end load (lbf)".into(),
+            reference: vec![(0.0, reference), (1.3 * elastic_tip, reference)],
+            measured: load_deflection,
+        }),
+    }
+}
+
+/// Thesis problem 4.3: plain concrete beam, 250 × 30 × 50 in, on line supports under its end
+/// planes' bottom rows (pin and roller), a uniform load on its top two layers; first cracking
+/// against beam theory, w = 8 f_r (I/c)/L² with L between the support lines.
+fn concrete_simply_supported(level: Level) -> Case {
+    let beam = ConcreteBeam::new(level, 250.0);
+    let dx = beam.dx;
+    let span = beam.length - dx;
+    let reference =
+        8.0 * ConcreteBeam::rupture_modulus() * ConcreteBeam::section_modulus() / (span * span);
+    let e = 3.605e6;
+    let inertia = CONCRETE_WIDTH * CONCRETE_DEPTH.powi(3) / 12.0;
+    let elastic_mid = 5.0 * reference * span.powi(4) / (384.0 * e * inertia);
+    let total = reference * beam.length;
+    let deck = format!(
+        r#"{head}[[boundary]]
+name = "pin"
+region = {{ shape = "box", min = "0 0 0 in", max = "{dx} {w} {dx} in" }}
+fixed = ["x", "y", "z"]
+[[boundary]]
+name = "roller"
+region = {{ shape = "box", min = "{roller_x} 0 0 in", max = "{length} {w} {dx} in" }}
+fixed = ["y", "z"]
+[[load]]
+name = "load"
+region = {{ shape = "box", min = "0 0 {top_z} in", max = "{length} {w} {d} in" }}
+total_force = "0 0 -{total} lbf"
+{ramp}
+[[probe]]
+name = "tip"
+at = "{mid_x} {y} 0 in"
+"#,
+        head = beam.deck_head("simply supported beam, uniform load", 0.2),
+        ramp = ConcreteBeam::ramp(0.2),
+        w = CONCRETE_WIDTH,
+        d = CONCRETE_DEPTH,
+        length = beam.length,
+        roller_x = beam.length - dx,
+        top_z = CONCRETE_DEPTH - 2.0 * dx,
+        mid_x = beam.length / 2.0,
+        y = CONCRETE_WIDTH / 2.0,
+    );
+    Case {
+        name: "concrete_simply_supported".into(),
+        quantity: "strength per length (load when the crack has run)".into(),
+        unit: "lbf/in",
+        kind: Kind::Strength,
+        reference,
+        thesis: Some(765.0),
+        formula: format!(
+            "beam theory w = 8·f_r·(I/c)/L², f_r = 7.5√f'c = {:.1} psi, I/c = {:.0} in³, L = {span} in between the support lines; thesis 4.3: sudden failure at 765 lb/in (its formula, with L = 250 in: 760 lb/in)",
+            ConcreteBeam::rupture_modulus(),
+            ConcreteBeam::section_modulus()
+        ),
+        tolerance_percent: 15.0,
+        deck,
+        // The history's load is the total over the 250 in; per length of beam.
+        extract: |summary, dir| Ok(failure_load(summary, dir)? / 250.0),
+        plot: Some(Plot {
+            x_label: "midspan deflection of the bottom (in)".into(),
+            y_label: "total load (lbf)".into(),
+            reference: vec![(0.0, total), (1.3 * elastic_mid, total)],
+            measured: load_deflection,
+        }),
+    }
+}
+
 /// The cases of a level, in report order.
 pub fn cases(level: Level) -> Vec<Case> {
     let models = ["pmb", "lps", "micropolar"];
     let mut all: Vec<Case> = models.iter().map(|m| cantilever(m, level)).collect();
     all.extend(models.iter().map(|m| simply_supported(m, level)));
+    all.push(concrete_cantilever(level));
+    all.push(concrete_simply_supported(level));
     all
 }
 
@@ -427,8 +683,7 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
     let seconds = start.elapsed().as_secs_f64();
     let measured = (case.extract)(&summary, dir)?;
     let error_percent = 100.0 * (measured - case.reference) / case.reference;
-    let passed = measured.is_finite()
-        && (case.kind == Kind::Strength || error_percent.abs() <= case.tolerance_percent);
+    let passed = measured.is_finite() && error_percent.abs() <= case.tolerance_percent;
     let plot = match &case.plot {
         Some(pl) => {
             let measured_curve = (pl.measured)(dir)?;
@@ -465,6 +720,7 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
         kind: case.kind,
         measured,
         reference: case.reference,
+        thesis: case.thesis,
         formula: case.formula.clone(),
         error_percent,
         tolerance_percent: case.tolerance_percent,
@@ -481,18 +737,23 @@ pub fn table(outcomes: &[Outcome]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| case | quantity | PDQ | reference | error % | tolerance % | result | particles | force evaluations | run time s |"
+        "| case | quantity | PDQ | reference | error % | tolerance % | result | thesis (PDQ against it) | particles | force evaluations | run time s |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
     for o in outcomes {
+        // Strength cases report against their tolerance; only elastic ones fail the run.
         let result = match (o.kind, o.passed) {
-            (Kind::Strength, _) => "reported",
+            (Kind::Strength, true) => "within",
+            (Kind::Strength, false) => "outside",
             (Kind::Elastic, true) => "pass",
             (Kind::Elastic, false) => "FAIL",
         };
+        let thesis = o.thesis.map_or("–".to_string(), |t| {
+            format!("{t:.5e} ({:+.2} %)", 100.0 * (o.measured - t) / t)
+        });
         let _ = writeln!(
             s,
-            "| {} | {} ({}) | {:.5e} | {:.5e} | {:+.2} | {} | {} | {} | {} | {:.1} |",
+            "| {} | {} ({}) | {:.5e} | {:.5e} | {:+.2} | {} | {} | {} | {} | {} | {:.1} |",
             o.name,
             o.quantity,
             o.unit,
@@ -501,6 +762,7 @@ pub fn table(outcomes: &[Outcome]) -> String {
             o.error_percent,
             o.tolerance_percent,
             result,
+            thesis,
             o.particles,
             o.force_evaluations,
             o.seconds
@@ -527,7 +789,8 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
     let mut all = cases(opts.level);
     let mut threads = opts.threads;
     if opts.implicit {
-        for case in &mut all {
+        // The elastic cases; the strength cases are solved implicitly already.
+        for case in all.iter_mut().filter(|c| c.kind == Kind::Elastic) {
             if !case.deck.contains(ADR_SOLVER) {
                 return Err(format!(
                     "case {}: no ADR solver block to replace",
@@ -556,7 +819,9 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
     {
         let dir = opts.output.join(&case.name);
         eprintln!("case       {} ...", case.name);
-        let o = run_case(case, &dir, threads)?;
+        // An implicit solve assembles one matrix in one process.
+        let implicit = case.deck.contains("kind = \"implicit\"");
+        let o = run_case(case, &dir, if implicit { 1 } else { threads })?;
         eprintln!(
             "           {} = {:.5e} {} against {:.5e} ({:+.2} %) in {:.1} s",
             o.quantity, o.measured, o.unit, o.reference, o.error_percent, o.seconds
@@ -591,7 +856,9 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
     }
     let path = opts.output.join("report.md");
     std::fs::write(&path, &report).map_err(|e| format!("{}: {e}", path.display()))?;
-    let ok = outcomes.iter().all(|o| o.passed);
+    let ok = outcomes
+        .iter()
+        .all(|o| o.passed || o.kind == Kind::Strength);
     Ok((t, ok))
 }
 

@@ -720,3 +720,10 @@ fn nan_in_a_history_table() {
     let line = line_of(&deck, "[[boundary]]");
     assert_rejected("nan_history", &deck, &["history", "finite"], Some(line));
 }
+
+/// A broken-bond count to stop at must be at least 1.
+#[test]
+fn stop_at_zero_broken_bonds() {
+    let deck = edit("steps = 10\n", "steps = 10\nstop_at_broken_bonds = 0\n");
+    assert_rejected("stop_zero", &deck, &["stop_at_broken_bonds", ">= 1"], None);
+}

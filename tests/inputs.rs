@@ -65,3 +65,47 @@ fn quick_example_runs_and_cracks() {
     assert!(dir.join("frames.xdmf").exists() && dir.join("timing.txt").exists());
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `[time] stop_at_broken_bonds` ends the run at the first step with that many broken bonds,
+/// with that step's history row as the last, and says so in the summary.
+#[test]
+fn a_run_stops_once_enough_bonds_have_broken() {
+    let text = std::fs::read_to_string("inputs/pmb_block.toml")
+        .unwrap()
+        .replace("[time]\n", "[time]\nstop_at_broken_bonds = 40\n");
+    let scene = deck::parse(&text, "pmb_block_stop.toml", "pmb_block_stop").unwrap();
+    let dir = std::env::temp_dir().join(format!("pdq-inputs-stop-{}", std::process::id()));
+    let s = run(
+        &scene,
+        &RunOptions {
+            output: Some(dir.clone()),
+            quiet: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!(s.stopped_at_broken, "the run must stop early");
+    assert!(
+        s.broken >= 40 && s.steps < 2000,
+        "{} broken at step {}",
+        s.broken,
+        s.steps
+    );
+    let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+    let last: Vec<f64> = history
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let header: Vec<&str> = history.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    assert_eq!(
+        last[col("step")] as u64,
+        s.steps,
+        "the stop step's row is the last"
+    );
+    assert!(last[col("broken_bonds")] >= 40.0);
+    std::fs::remove_dir_all(dir).unwrap();
+}

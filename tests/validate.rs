@@ -73,6 +73,7 @@ history_every = 1
             unit: "m",
             kind: Kind::Elastic,
             reference: 1.0,
+            thesis: None,
             formula: "none".into(),
             tolerance_percent: 2.0,
             deck: deck.into(),
@@ -91,6 +92,7 @@ history_every = 1
         unit: "m",
         kind: Kind::Elastic,
         reference: 2.0 * measured,
+        thesis: None,
         formula: "twice the answer".into(),
         tolerance_percent: 2.0,
         deck: deck.into(),
@@ -103,6 +105,20 @@ history_every = 1
     let table = validate::table(&[o]);
     assert!(
         table.contains("FAIL") && table.contains("-50.00"),
+        "{table}"
+    );
+    // A strength case outside its tolerance is reported, not failed, with the thesis's value
+    // as a second reference.
+    let strength = Case {
+        kind: Kind::Strength,
+        thesis: Some(measured),
+        ..case
+    };
+    let o = validate::run_case(&strength, &dir, 1).unwrap();
+    assert!(!o.passed);
+    let table = validate::table(&[o]);
+    assert!(
+        table.contains("outside") && table.contains("(+0.00 %)"),
         "{table}"
     );
     let _ = std::fs::remove_dir_all(dir);
