@@ -64,6 +64,10 @@ enum Cmd {
         /// (force evaluations to the same residual).
         #[arg(long)]
         compare_adr: bool,
+        /// With --compare-adr: the explicit run ramps the load over this many periods of the
+        /// first bending mode (then holds it for three); a longer ramp leaves less vibration.
+        #[arg(long, default_value_t = 5.0)]
+        ramp_periods: f64,
         /// Quasi-static solver of the cases: "adr" or "implicit" (one thread).
         #[arg(long, default_value = "adr", value_parser = ["adr", "implicit"])]
         solver: String,
@@ -204,8 +208,9 @@ fn main() -> ExitCode {
             output,
             threads,
             compare_adr: true,
+            ramp_periods,
             ..
-        } => pdq::validate::compare_adr(&output, threads).map(|s| print!("{s}")),
+        } => pdq::validate::compare_adr(&output, threads, ramp_periods).map(|s| print!("{s}")),
         Cmd::Validate {
             quick: _,
             full,

@@ -99,13 +99,18 @@ pub fn read_history(dir: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), String> 
     Ok((header, rows))
 }
 
-/// The last value of a history column.
-pub fn last_of(dir: &Path, column: &str) -> Result<f64, String> {
-    let (header, rows) = read_history(dir)?;
-    let c = header
+/// The index of a history column.
+fn column(header: &[String], name: &str) -> Result<usize, String> {
+    header
         .iter()
-        .position(|h| h == column)
-        .ok_or_else(|| format!("history.csv has no column '{column}'"))?;
+        .position(|h| h == name)
+        .ok_or_else(|| format!("history.csv has no column '{name}'"))
+}
+
+/// The last value of a history column.
+pub fn last_of(dir: &Path, name: &str) -> Result<f64, String> {
+    let (header, rows) = read_history(dir)?;
+    let c = column(&header, name)?;
     rows.last()
         .map(|r| r[c])
         .ok_or_else(|| "history.csv has no rows".to_string())
@@ -282,6 +287,24 @@ at = "{tip_x} {mid} {mid} m"
     }
 }
 
+/// Line supports under the bottom row of a beam's end planes, as deck text: a pin (x, y, z
+/// fixed) at x ∈ [0, dx] and a roller (y, z) at x ∈ [length − dx, length], both across the
+/// width and one plane high; lengths in `unit`.
+fn line_supports(dx: f64, width: f64, length: f64, unit: &str) -> String {
+    format!(
+        r#"[[boundary]]
+name = "pin"
+region = {{ shape = "box", min = "0 0 0 {unit}", max = "{dx} {width} {dx} {unit}" }}
+fixed = ["x", "y", "z"]
+[[boundary]]
+name = "roller"
+region = {{ shape = "box", min = "{roller_x} 0 0 {unit}", max = "{length} {width} {dx} {unit}" }}
+fixed = ["y", "z"]
+"#,
+        roller_x = length - dx
+    )
+}
+
 /// A simply supported beam of `model` (span 20 sections between the support lines) under a
 /// uniform load on its top layer; the midspan deflection of the beam's axis relative to the
 /// axis above the supports (which removes the local indentation of the line supports, which
@@ -299,15 +322,7 @@ fn simply_supported(model: &str, level: Level) -> Case {
     let shear = w * span * span / (8.0 * shear_stiffness);
     let mid = h / 2.0;
     let deck = format!(
-        r#"{head}[[boundary]]
-name = "pin"
-region = {{ shape = "box", min = "0 0 0 m", max = "{dx} {h} {dx} m" }}
-fixed = ["x", "y", "z"]
-[[boundary]]
-name = "roller"
-region = {{ shape = "box", min = "{roller_x} 0 0 m", max = "{length_x} {h} {dx} m" }}
-fixed = ["y", "z"]
-[[load]]
+        r#"{head}{supports}[[load]]
 name = "top"
 region = {{ shape = "box", min = "0 0 {top_z} m", max = "{length_x} {h} {h} m" }}
 total_force = "0 0 -{total} N"
@@ -322,7 +337,7 @@ name = "right"
 at = "{right_x} {mid} {mid} m"
 {BEAM_OUTPUT}"#,
         head = beam.deck_head("simply supported beam, uniform load", length_x),
-        roller_x = length_x - dx,
+        supports = line_supports(dx, h, length_x, "m"),
         top_z = h - dx,
         mid_x = length_x / 2.0,
         left_x = dx / 2.0,
@@ -421,6 +436,8 @@ struct ConcreteBeam {
 /// Section of the thesis's beams: 30 in wide (y), 50 in deep (z).
 const CONCRETE_WIDTH: f64 = 30.0;
 const CONCRETE_DEPTH: f64 = 50.0;
+/// The thesis's concrete modulus, 3605 ksi (= 57,000√f'c psi), in psi.
+const CONCRETE_E: f64 = 3.605e6;
 
 impl ConcreteBeam {
     fn new(level: Level, length: f64) -> ConcreteBeam {
@@ -437,9 +454,14 @@ impl ConcreteBeam {
         7.5 * 4000f64.sqrt()
     }
 
+    /// I of the section.
+    fn inertia() -> f64 {
+        CONCRETE_WIDTH * CONCRETE_DEPTH.powi(3) / 12.0
+    }
+
     /// I/c of the section.
     fn section_modulus() -> f64 {
-        CONCRETE_WIDTH * CONCRETE_DEPTH.powi(3) / 12.0 / (CONCRETE_DEPTH / 2.0)
+        Self::inertia() / (CONCRETE_DEPTH / 2.0)
     }
 
     /// Bonds crossing a quarter of the section: a plane cuts π m⁴/4 bonds per dx² of a simple
@@ -466,7 +488,7 @@ spacing = "{dx} in"
 [materials.concrete]
 kind = "concrete"
 density = "145 lb/ft^3"
-youngs_modulus = "3605 ksi"
+youngs_modulus = "{CONCRETE_E} psi"
 poisson_ratio = 0.25
 tensile_stretch = 1.387e-4
 compressive_stretch = -1.1e-3
@@ -522,12 +544,7 @@ fn failure_load(summary: &Summary, dir: &Path) -> Result<f64, String> {
 /// (deflection at the probe named `tip`, applied load) over the history rows.
 fn load_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
     let (header, rows) = read_history(dir)?;
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| format!("history.csv has no column '{name}'"))
-    };
+    let col = |name: &str| column(&header, name);
     let (load, uz) = (col("load_load")?, col("tip_uz")?);
     Ok(rows.iter().map(|r| (-r[uz], r[load])).collect())
 }
@@ -540,9 +557,7 @@ fn concrete_cantilever(level: Level) -> Case {
     let dx = beam.dx;
     let arm = (beam.length - dx) - 3.0 * dx;
     let reference = ConcreteBeam::rupture_modulus() * ConcreteBeam::section_modulus() / arm;
-    let e = 3.605e6;
-    let inertia = CONCRETE_WIDTH * CONCRETE_DEPTH.powi(3) / 12.0;
-    let elastic_tip = reference * arm.powi(3) / (3.0 * e * inertia);
+    let elastic_tip = reference * arm.powi(3) / (3.0 * CONCRETE_E * ConcreteBeam::inertia());
     let deck = format!(
         r#"{head}[[boundary]]
 name = "clamp"
@@ -598,20 +613,11 @@ fn concrete_simply_supported(level: Level) -> Case {
     let span = beam.length - dx;
     let reference =
         8.0 * ConcreteBeam::rupture_modulus() * ConcreteBeam::section_modulus() / (span * span);
-    let e = 3.605e6;
-    let inertia = CONCRETE_WIDTH * CONCRETE_DEPTH.powi(3) / 12.0;
-    let elastic_mid = 5.0 * reference * span.powi(4) / (384.0 * e * inertia);
+    let elastic_mid =
+        5.0 * reference * span.powi(4) / (384.0 * CONCRETE_E * ConcreteBeam::inertia());
     let total = reference * beam.length;
     let deck = format!(
-        r#"{head}[[boundary]]
-name = "pin"
-region = {{ shape = "box", min = "0 0 0 in", max = "{dx} {w} {dx} in" }}
-fixed = ["x", "y", "z"]
-[[boundary]]
-name = "roller"
-region = {{ shape = "box", min = "{roller_x} 0 0 in", max = "{length} {w} {dx} in" }}
-fixed = ["y", "z"]
-[[load]]
+        r#"{head}{supports}[[load]]
 name = "load"
 region = {{ shape = "box", min = "0 0 {top_z} in", max = "{length} {w} {d} in" }}
 total_force = "0 0 -{total} lbf"
@@ -625,7 +631,7 @@ at = "{mid_x} {y} 0 in"
         w = CONCRETE_WIDTH,
         d = CONCRETE_DEPTH,
         length = beam.length,
-        roller_x = beam.length - dx,
+        supports = line_supports(dx, CONCRETE_WIDTH, beam.length, "in"),
         top_z = CONCRETE_DEPTH - 2.0 * dx,
         mid_x = beam.length / 2.0,
         y = CONCRETE_WIDTH / 2.0,
@@ -863,10 +869,15 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
 }
 
 /// ADR against an explicit load ramp on the quick LPS cantilever: the explicit run ramps the
-/// load over five periods of the beam's first bending mode and holds it for three; the
+/// load over `ramp_periods` periods of the beam's first bending mode and holds it for three; the
 /// smallest relative residual it reaches after the ramp is then asked of ADR, and the force
 /// evaluations of both are compared. Returns the lines to print.
-pub fn compare_adr(output: &Path, threads: usize) -> Result<String, String> {
+pub fn compare_adr(output: &Path, threads: usize, ramp_periods: f64) -> Result<String, String> {
+    if !(ramp_periods.is_finite() && ramp_periods > 0.0) {
+        return Err(format!(
+            "--ramp-periods must be a number of periods > 0 (got {ramp_periods})"
+        ));
+    }
     let case = cantilever("lps", Level::Quick);
     // First bending period: ω₁ = 1.875² √(EI / (ρ A L⁴)) with the case's section and span.
     let (e, rho, h, span): (f64, f64, f64, f64) = (10.0e9, 2400.0, 0.07, 0.70);
@@ -881,13 +892,13 @@ pub fn compare_adr(output: &Path, threads: usize) -> Result<String, String> {
         .replace(adr_block, "")
         .replace(
             "duration = \"1 s\"",
-            &format!("duration = \"{} s\"", 8.0 * period),
+            &format!("duration = \"{} s\"", (ramp_periods + 3.0) * period),
         )
         .replace(
             "total_force = \"0 0 -1000 N\"",
             &format!(
                 "total_force = \"0 0 -1000 N\"\nhistory = {{ ramp = \"{} s\" }}",
-                5.0 * period
+                ramp_periods * period
             ),
         )
         .replace("history_every = 1\nframes_every = 1", "history_every = 20");
@@ -906,12 +917,7 @@ pub fn compare_adr(output: &Path, threads: usize) -> Result<String, String> {
     )?;
     let explicit_seconds = t.elapsed().as_secs_f64();
     let (header, rows) = read_history(&dir)?;
-    let col = |name: &str| {
-        header
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| format!("history has no column '{name}'"))
-    };
+    let col = |name: &str| column(&header, name);
     let (time, load, force) = (col("time")?, col("load_tip")?, col("residual_force")?);
     let reactions: Vec<usize> = ["x", "y", "z"]
         .iter()
@@ -923,7 +929,7 @@ pub fn compare_adr(output: &Path, threads: usize) -> Result<String, String> {
     };
     let (best_row, best) = rows
         .iter()
-        .filter(|r| r[time] >= 5.0 * period)
+        .filter(|r| r[time] >= ramp_periods * period)
         .map(|r| (r, relative(r)))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .ok_or("the explicit run has no rows after its ramp")?;
@@ -946,7 +952,7 @@ pub fn compare_adr(output: &Path, threads: usize) -> Result<String, String> {
     )?;
     let adr_seconds = t.elapsed().as_secs_f64();
     Ok(format!(
-        "explicit load ramp (5 periods of {:.2} ms, then held; {} steps in all, {explicit_seconds:.1} s): smallest relative residual after the ramp {best:.2e}, reached at step {explicit_evaluations}\nADR to the same residual: {} force evaluations ({adr_seconds:.1} s)\nratio explicit/ADR force evaluations: {:.1}\n",
+        "explicit load ramp ({ramp_periods} periods of {:.2} ms, then held for 3; {} steps in all, {explicit_seconds:.1} s): smallest relative residual after the ramp {best:.2e}, reached at step {explicit_evaluations}\nADR to the same residual: {} force evaluations ({adr_seconds:.1} s)\nratio explicit/ADR force evaluations: {:.1}\n",
         1e3 * period,
         s.steps,
         a.force_evaluations,
