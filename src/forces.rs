@@ -374,8 +374,10 @@ where
                         k = next;
                         continue;
                     }
-                    end = next;
                 }
+                // A refused group, or fewer than four intact bonds left (then `next` is the
+                // end of the list): one by one up to where the search stopped.
+                end = next;
             }
             while k < end {
                 if !(DAMAGE && broken[k]) {
