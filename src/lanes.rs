@@ -43,16 +43,6 @@ impl Real for f64 {
     }
 }
 
-/// Lane `l` of each component of a lane vector.
-#[inline(always)]
-pub fn lane<const N: usize>(v: &[F4; N], l: usize) -> [f64; N] {
-    let mut out = [0.0; N];
-    for k in 0..N {
-        out[k] = v[k].lane(l);
-    }
-    out
-}
-
 /// Most generalized-force components a model with lanes may have (micropolar: 6).
 pub const MAX_COMPONENTS: usize = 8;
 
@@ -337,8 +327,6 @@ mod array {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
     /// The same tests for the form in use and, where that is the register form, for the
     /// portable one.
     macro_rules! lane_tests {
@@ -394,10 +382,4 @@ mod tests {
 
     lane_tests!(in_use, super::super::F4);
     lane_tests!(portable, super::super::array::F4);
-
-    #[test]
-    fn lane_reads_each_component() {
-        let v = [F4::gather(|l| l as f64), F4::gather(|l| 10.0 + l as f64)];
-        assert_eq!(lane(&v, 2), [2.0, 12.0]);
-    }
 }
