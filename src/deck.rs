@@ -292,6 +292,7 @@ struct OutputSection {
 struct ProbeSection {
     name: String,
     at: Position,
+    stop_beyond: Option<Length>,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -435,6 +436,9 @@ pub struct ProbeSpec {
     pub name: String,
     pub line: usize,
     pub at: [f64; 3],
+    /// The run ends at the first history row where this probe's displacement is longer than
+    /// this (`stop_beyond`; infinite when not given).
+    pub stop_beyond: f64,
 }
 
 /// A deck after checking and unit conversion: everything in the deck's unit system.
@@ -961,10 +965,24 @@ impl Converter {
             if probes.iter().any(|p: &ProbeSpec| p.name == name) {
                 return self.err(line, format!("probe name '{name}' is used twice"));
             }
+            let stop_beyond = match &p.get_ref().stop_beyond {
+                None => f64::INFINITY,
+                Some(d) => {
+                    let d = d.value(sys);
+                    if !(d.is_finite() && d > 0.0) {
+                        return self.err(
+                            line,
+                            format!("probe '{name}': stop_beyond must be a length > 0 (got {d})"),
+                        );
+                    }
+                    d
+                }
+            };
             probes.push(ProbeSpec {
                 name,
                 line,
                 at: self.finite3(p.get_ref().at.value(sys), line, "probe: 'at'")?,
+                stop_beyond,
             });
         }
 

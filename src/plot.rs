@@ -106,3 +106,224 @@ pub fn xy(
     root.present().map_err(|e| err(&e))?;
     Ok(())
 }
+
+/// The particles of one frame, for [`damage_views`].
+pub struct Body<'a> {
+    /// Reference positions.
+    pub x0: &'a [[f64; 3]],
+    pub displacement: &'a [[f64; 3]],
+    pub damage: &'a [f64],
+    /// Lattice spacing: each particle is drawn as a square of this size.
+    pub spacing: f64,
+}
+
+/// Damage from 0 (intact, blue) through yellow to 1 (all bonds broken, dark red), the thesis's
+/// figures' reading: cracks stand out against an intact body.
+fn damage_colour(d: f64) -> RGBColor {
+    let stops: [(f64, [f64; 3]); 5] = [
+        (0.0, [40.0, 70.0, 160.0]),
+        (0.15, [70.0, 160.0, 200.0]),
+        (0.35, [250.0, 220.0, 60.0]),
+        (0.6, [235.0, 110.0, 30.0]),
+        (1.0, [140.0, 10.0, 10.0]),
+    ];
+    let d = if d.is_finite() {
+        d.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
+    let k = stops.iter().position(|s| s.0 >= d).unwrap_or(4).max(1);
+    let ((a, ca), (b, cb)) = (stops[k - 1], stops[k]);
+    let t = ((d - a) / (b - a)).clamp(0.0, 1.0);
+    let c = |i: usize| (ca[i] + t * (cb[i] - ca[i])).round() as u8;
+    RGBColor(c(0), c(1), c(2))
+}
+
+/// Writes the deformed body coloured by damage to `path` (PNG, 1200 × 960): a side view (along
+/// +y, the x–z plane) above an oblique 3D view from the front, left and above. Displacements
+/// are drawn `magnify` times; particles are squares painted far to near, so what shows is the
+/// body's visible surface, as in the thesis's figures.
+pub fn damage_views(path: &Path, title: &str, body: &Body, magnify: f64) -> Result<(), String> {
+    register_font();
+    let err = |e: &dyn std::fmt::Display| format!("plot {}: {e}", path.display());
+    let n = body.x0.len();
+    if n == 0 || body.displacement.len() != n || body.damage.len() != n {
+        return Err(format!("plot {}: no particles to draw", path.display()));
+    }
+    let deformed: Vec<[f64; 3]> = body
+        .x0
+        .iter()
+        .zip(body.displacement)
+        .map(|(x, u)| [0, 1, 2].map(|k| x[k] + magnify * u[k]))
+        .collect();
+    let root = BitMapBackend::new(path, (1200, 960)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let (top, rest) = root.split_vertically(40);
+    top.draw(&Text::new(
+        title.to_string(),
+        (14, 10),
+        ("sans-serif", 20).into_font(),
+    ))
+    .map_err(|e| err(&e))?;
+    let (side, oblique) = rest.split_vertically(330);
+    // Side: screen right = +x, up = +z, depth = +y (the y = min face is nearest).
+    let side_basis = ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]);
+    // Oblique: the camera looks along v from the front (−y), left (−x) and above (+z).
+    let (az, el) = (30f64.to_radians(), 22f64.to_radians());
+    let v = [az.sin() * el.cos(), az.cos() * el.cos(), -el.sin()];
+    let right = normalise(cross(v, [0.0, 0.0, 1.0]));
+    let up = cross(right, v);
+    for (area, basis, label) in [
+        (&side, side_basis, "side view (x right, z up)"),
+        (
+            &oblique,
+            (right, up, v),
+            "3D view from the front, left and above",
+        ),
+    ] {
+        draw_projection(area, &deformed, body, basis, label).map_err(|e| err(&e))?;
+    }
+    draw_colour_bar(&oblique).map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn normalise(a: [f64; 3]) -> [f64; 3] {
+    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    a.map(|c| c / l)
+}
+
+fn dot(a: [f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// Paints the particles projected on the (right, up) plane of `basis`, farthest along its
+/// depth axis first, fitted into `area` at equal scale on both axes.
+fn draw_projection(
+    area: &Area,
+    deformed: &[[f64; 3]],
+    body: &Body,
+    (right, up, depth): ([f64; 3], [f64; 3], [f64; 3]),
+    label: &str,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let screen: Vec<(f64, f64, f64)> = deformed
+        .iter()
+        .map(|p| (dot(right, p), dot(up, p), dot(depth, p)))
+        .collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y, _) in screen.iter().filter(|s| s.0.is_finite() && s.1.is_finite()) {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    let (w, h) = area.dim_in_pixel();
+    let margin = 30.0;
+    let half = 0.5 * body.spacing;
+    let scale = ((w as f64 - 2.0 * margin) / (x1 - x0 + 2.0 * half))
+        .min((h as f64 - 2.0 * margin) / (y1 - y0 + 2.0 * half));
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err("the body has no extent to draw".into());
+    }
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let px = |x: f64, y: f64| {
+        (
+            (0.5 * w as f64 + (x - cx) * scale).round() as i32,
+            (0.5 * h as f64 - (y - cy) * scale).round() as i32,
+        )
+    };
+    // Far first; equal depths in id order, so the picture does not depend on sort stability.
+    let mut order: Vec<usize> = (0..screen.len())
+        .filter(|&i| screen[i].0.is_finite() && screen[i].1.is_finite())
+        .collect();
+    order.sort_by(|&a, &b| screen[b].2.total_cmp(&screen[a].2).then(a.cmp(&b)));
+    // Half a pixel more than the particle's cube, so that rounding leaves no gaps.
+    let r = half * scale + 0.5;
+    for i in order {
+        let (x, y, _) = screen[i];
+        let (a, b) = (
+            px(x - r / scale, y + r / scale),
+            px(x + r / scale, y - r / scale),
+        );
+        let b = (b.0.max(a.0 + 1), b.1.max(a.1 + 1));
+        area.draw(&Rectangle::new(
+            [a, b],
+            damage_colour(body.damage[i]).filled(),
+        ))?;
+    }
+    area.draw(&Text::new(
+        label.to_string(),
+        (14, 6),
+        ("sans-serif", 16).into_font(),
+    ))?;
+    Ok(())
+}
+
+/// A horizontal damage scale in the lower right corner of `area`.
+fn draw_colour_bar(area: &Area) -> Result<(), Box<dyn std::error::Error>> {
+    let (w, h) = area.dim_in_pixel();
+    let (x0, y0, len) = (w as i32 - 330, h as i32 - 40, 240);
+    for k in 0..len {
+        let d = k as f64 / (len - 1) as f64;
+        area.draw(&Rectangle::new(
+            [(x0 + k, y0), (x0 + k + 1, y0 + 14)],
+            damage_colour(d).filled(),
+        ))?;
+    }
+    let font = ("sans-serif", 14).into_font();
+    area.draw(&Text::new("damage 0", (x0 - 70, y0), font.clone()))?;
+    area.draw(&Text::new("1", (x0 + len + 6, y0), font))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pixels(path: &Path) -> (u32, Vec<u8>) {
+        let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!(info.color_type, png::ColorType::Rgb);
+        (info.width, buf)
+    }
+
+    /// Two particles one behind the other along y: the side view shows the near one (y = 0,
+    /// intact), not the far one (broken), wherever they are painted; a third, alone, shows its
+    /// damage colour.
+    #[test]
+    fn the_side_view_shows_the_near_face() {
+        let path = std::env::temp_dir().join(format!("pdq-views-{}.png", std::process::id()));
+        let x0 = [[0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [4.0, 0.0, 0.0]];
+        let body = Body {
+            x0: &x0,
+            displacement: &[[0.0; 3]; 3],
+            damage: &[1.0, 0.0, 0.5],
+            spacing: 1.0,
+        };
+        damage_views(&path, "test", &body, 1.0).unwrap();
+        let (width, rgb) = pixels(&path);
+        let count = |c: RGBColor| {
+            rgb.chunks_exact(3)
+                .take(width as usize * 370) // the title and the side view
+                .filter(|p| p[0] == c.0 && p[1] == c.1 && p[2] == c.2)
+                .count()
+        };
+        let (intact, broken, half) = (damage_colour(0.0), damage_colour(1.0), damage_colour(0.5));
+        assert!(count(intact) > 1000, "the near particle is drawn");
+        assert!(count(half) > 1000, "the lone particle is drawn");
+        assert_eq!(count(broken), 0, "the far particle is hidden");
+        let _ = std::fs::remove_file(path);
+    }
+}

@@ -50,6 +50,9 @@ pub struct Summary {
     pub converged_steps: u64,
     /// The run ended before its last step because `[time] stop_at_broken_bonds` was reached.
     pub stopped_at_broken: bool,
+    /// The run ended before its last step because this probe's displacement passed its
+    /// `stop_beyond`.
+    pub stopped_at_probe: Option<String>,
 }
 
 /// Options the command line may set over the deck.
@@ -365,6 +368,8 @@ struct Plan {
     /// `[time] stop_at_broken_bonds` (0 = off).
     stop_at_broken: u64,
     n_probes: usize,
+    /// Each probe's name and `stop_beyond` (infinite when not given), in deck order.
+    probe_stops: Vec<(String, f64)>,
     layout: String,
     /// The step the loop starts from: 0, or the step of the checkpoint it resumes.
     first_step: u64,
@@ -460,6 +465,7 @@ fn drive<M: Model>(
     let mut broken = 0usize;
     let mut shuffles = 0u64;
     let mut stopped_at_broken = false;
+    let mut stopped_at_probe = None;
     for step in first..=plan.steps {
         if step > first {
             let r = match &plan.relaxation {
@@ -504,7 +510,7 @@ fn drive<M: Model>(
             n[0] >= plan.stop_at_broken as f64
         };
         stopped_at_broken |= halted;
-        let last = step == plan.steps || halted;
+        let mut last = step == plan.steps || halted;
         // A restarted run has the row and frame of its first step from before.
         let again = first > 0 && step == first;
         let want_row = (step % plan.every == 0 || last) && !again;
@@ -519,8 +525,21 @@ fn drive<M: Model>(
                 return Err(blow_up(&mut cube, plan, store, frames, gid, step));
             }
             let damage = cube.damage();
+            let mut probe_halt = None;
             if want_row {
                 let mut r = row(&mut cube, &damage, plan.n_probes);
+                // The probes' displacements end the row (before the residual); every worker
+                // has the whole row, so all stop alike.
+                let first_probe = r.len() - 1 - 3 * plan.n_probes;
+                probe_halt = plan
+                    .probe_stops
+                    .iter()
+                    .enumerate()
+                    .find_map(|(k, (name, limit))| {
+                        let u = &r[first_probe + 3 * k..first_probe + 3 * k + 3];
+                        let length = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+                        (length > *limit).then(|| name.clone())
+                    });
                 if plan.relaxation.is_some() {
                     let last = relaxed.unwrap_or_default();
                     r.push(last.iterations as f64);
@@ -532,6 +551,12 @@ fn drive<M: Model>(
                         error = Some(io(e));
                     }
                 }
+            }
+            // A probe's stop makes this the last step: its frame is written too.
+            let want_frame = want_frame || (plan.frames_every > 0 && probe_halt.is_some());
+            if probe_halt.is_some() {
+                last = true;
+                stopped_at_probe = probe_halt;
             }
             if want_frame {
                 gather_frame(&mut cube, &damage, &mut store);
@@ -588,7 +613,7 @@ fn drive<M: Model>(
                 break;
             }
         }
-        if halted {
+        if last {
             break;
         }
     }
@@ -718,6 +743,7 @@ fn drive<M: Model>(
         force_evaluations: evaluations,
         converged_steps: converged,
         stopped_at_broken,
+        stopped_at_probe,
     }))
 }
 
@@ -882,6 +908,11 @@ fn run_setup<M: Model>(
         shuffle_every: scene.parallel.shuffle_every,
         stop_at_broken: scene.time.stop_at_broken_bonds,
         n_probes: setup.probes.len(),
+        probe_stops: scene
+            .probes
+            .iter()
+            .map(|p| (p.name.clone(), p.stop_beyond))
+            .collect(),
         layout: layout.describe(),
         first_step: resume.map_or(0, |c| c.step),
         relaxation: relaxation.clone(),
@@ -1040,6 +1071,12 @@ fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
         eprintln!(
             "stopped    at step {}: {} broken bonds reached [time] stop_at_broken_bonds",
             summary.steps, summary.broken
+        );
+    }
+    if let Some(probe) = &summary.stopped_at_probe {
+        eprintln!(
+            "stopped    at step {}: probe '{probe}' moved beyond its stop_beyond",
+            summary.steps
         );
     }
     eprintln!(

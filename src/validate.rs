@@ -38,6 +38,9 @@ pub struct Plot {
     pub measured: CurveReader,
 }
 
+/// Reads the measured value from a run's summary and output directory.
+pub type Extractor = Box<dyn Fn(&Summary, &Path) -> Result<f64, String>>;
+
 /// One validation case.
 pub struct Case {
     pub name: String,
@@ -52,8 +55,10 @@ pub struct Case {
     pub tolerance_percent: f64,
     pub deck: String,
     /// The measured value from the run's summary and output directory.
-    pub extract: fn(&Summary, &Path) -> Result<f64, String>,
+    pub extract: Extractor,
     pub plot: Option<Plot>,
+    /// Draw the last frame's deformed body coloured by damage (side and 3D views).
+    pub damage_views: bool,
 }
 
 /// What running a case gave.
@@ -73,6 +78,8 @@ pub struct Outcome {
     pub seconds: f64,
     pub passed: bool,
     pub plot: Option<PathBuf>,
+    /// The damage picture (side and 3D views), for the cases that draw one.
+    pub views: Option<PathBuf>,
 }
 
 /// The columns of `history.csv` by name, and its rows.
@@ -135,6 +142,14 @@ impl Beam {
             Level::Quick => (7, 3.0),
             Level::Full => (13, 3.0),
         };
+        let cells = std::env::var("PDQ_CELLS")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(cells);
+        let m = std::env::var("PDQ_M")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(m);
         Beam {
             model: model.to_string(),
             cells,
@@ -269,7 +284,8 @@ at = "{tip_x} {mid} {mid} m"
         ),
         tolerance_percent: 2.0,
         deck,
-        extract: |_, dir| Ok(-last_of(dir, "tip_uz")?),
+        extract: Box::new(|_, dir| Ok(-last_of(dir, "tip_uz")?)),
+        damage_views: false,
         plot: Some(Plot {
             x_label: "x (m)".into(),
             y_label: "deflection of the beam axis (m)".into(),
@@ -315,7 +331,10 @@ fn simply_supported(model: &str, level: Level) -> Case {
     // An odd number of planes puts one at midspan; supports under the end planes.
     let length_x = (20 * beam.cells + 1) as f64 * dx;
     let span = length_x - dx;
-    let total: f64 = 20_000.0;
+    let total: f64 = std::env::var("PDQ_SSLOAD")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(20_000.0);
     let w = total / length_x;
     let (inertia, shear_stiffness) = (beam.inertia(), beam.shear_stiffness());
     let bending = 5.0 * w * span.powi(4) / (384.0 * e * inertia);
@@ -356,11 +375,12 @@ at = "{right_x} {mid} {mid} m"
         ),
         tolerance_percent: 2.0,
         deck,
-        extract: |_, dir| {
+        extract: Box::new(|_, dir| {
             let mid = last_of(dir, "mid_uz")?;
             let ends = 0.5 * (last_of(dir, "left_uz")? + last_of(dir, "right_uz")?);
             Ok(ends - mid)
-        },
+        }),
+        damage_views: false,
         plot: Some(Plot {
             x_label: "x (m)".into(),
             y_label: "deflection of the beam axis (m)".into(),
@@ -379,29 +399,94 @@ at = "{right_x} {mid} {mid} m"
     }
 }
 
-/// (x₀, u_z) of the particles on the beam's axis in the last frame (those nearest the line
-/// through the section's centre along x).
-fn axis_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
+/// The particles of a run's last frame: reference positions, displacements, damage and volumes.
+struct Frame {
+    x0: Vec<[f64; 3]>,
+    u: Vec<[f64; 3]>,
+    damage: Vec<f64>,
+    volume: Vec<f64>,
+}
+
+/// The last frame of the run in `dir`.
+fn last_frame(dir: &Path) -> Result<Frame, String> {
     let frames = dir.join("frames");
+    // Frame files are named by their zero-padded step, so name order is step order.
     let mut files: Vec<PathBuf> = std::fs::read_dir(&frames)
         .map_err(|e| format!("{}: {e}", frames.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "h5"))
         .collect();
     files.sort();
-    let last = files.last().ok_or("no frames")?;
+    let last = files
+        .last()
+        .ok_or_else(|| format!("{}: no frames", frames.display()))?;
     let f = hdf5_pure::File::open(last).map_err(|e| format!("{}: {e}", last.display()))?;
     let read = |name: &str| {
         f.dataset(name)
             .and_then(|d| d.read_f64())
             .map_err(|e| format!("{}: {name}: {e}", last.display()))
     };
-    let (points, u) = (read("points")?, read("displacement")?);
-    let x0: Vec<[f64; 3]> = points
-        .chunks_exact(3)
-        .zip(u.chunks_exact(3))
+    let vectors =
+        |v: Vec<f64>| -> Vec<[f64; 3]> { v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect() };
+    let (points, u) = (vectors(read("points")?), vectors(read("displacement")?));
+    let x0 = points
+        .iter()
+        .zip(&u)
         .map(|(p, u)| [p[0] - u[0], p[1] - u[1], p[2] - u[2]])
         .collect();
+    Ok(Frame {
+        x0,
+        u,
+        damage: read("damage")?,
+        volume: read("volume")?,
+    })
+}
+
+/// Draws the last frame of the run in `dir` coloured by damage into `path`, the displacements
+/// magnified (never shrunk) so that the largest is 4 % of the body's length.
+fn draw_damage_views(dir: &Path, path: &Path, title: &str) -> Result<(), String> {
+    let frame = last_frame(dir)?;
+    let extent = (0..3)
+        .map(|k| {
+            let (lo, hi) = frame
+                .x0
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x[k]), b.max(x[k])));
+            hi - lo
+        })
+        .fold(0.0, f64::max);
+    let largest = frame
+        .u
+        .iter()
+        .map(|u| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt())
+        .filter(|d| d.is_finite())
+        .fold(0.0, f64::max);
+    let magnify = if largest > 0.0 {
+        (0.04 * extent / largest).max(1.0)
+    } else {
+        1.0
+    };
+    // Lattice particles fill a cube of their volume; bar particles are drawn at that size too.
+    let mut volumes = frame.volume.clone();
+    volumes.sort_by(f64::total_cmp);
+    let spacing = volumes[volumes.len() / 2].cbrt();
+    crate::plot::damage_views(
+        path,
+        &format!("{title}; displacements × {magnify:.1}"),
+        &crate::plot::Body {
+            x0: &frame.x0,
+            displacement: &frame.u,
+            damage: &frame.damage,
+            spacing,
+        },
+        magnify,
+    )
+}
+
+/// (x₀, u_z) of the particles on the beam's axis in the last frame (those nearest the line
+/// through the section's centre along x).
+fn axis_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
+    let Frame { x0, u, .. } = last_frame(dir)?;
     let centre = |k: usize| {
         let (lo, hi) = x0
             .iter()
@@ -413,7 +498,7 @@ fn axis_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
     let nearest = x0.iter().map(off).fold(f64::MAX, f64::min);
     let mut line: Vec<(f64, f64)> = x0
         .iter()
-        .zip(u.chunks_exact(3))
+        .zip(&u)
         .filter(|(x, _)| off(x) <= nearest + 1e-9)
         .map(|(x, u)| (x[0], u[2]))
         .collect();
@@ -421,16 +506,32 @@ fn axis_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
     Ok(line)
 }
 
-/// The thesis's plain concrete beams (problems 4.1 and 4.3, THEORY.md §8): its concrete (E =
-/// 3605 ksi, ν = ¼, s_t = 1.387e-4, s_c = −1.1e-3, f'c = 4000 psi), 200 or 250 × 30 × 50 in,
-/// on the thesis's 1 in lattice (`--full`) or a 2.5 in one (`--quick`), m = 3, the energy
-/// surface correction. As in the thesis, the load is ramped in an explicit dynamic run; the
-/// run stops when the crack has run, i.e. when about as many bonds have broken as cross a
-/// quarter of the section, and the load at that step is the measured strength. The first bonds break
-/// earlier, at the supports' corners (validation/README.md), and are not the beam's cracking.
+/// The thesis's concrete beams (problems 4.1–4.4, THEORY.md §8): its concrete (E = 3605 ksi,
+/// ν = ¼, s_t = 1.387e-4, s_c = −1.1e-3, f'c = 4000 psi), 200 or 250 × 30 × 50 in, on the
+/// thesis's 1 in lattice (`--full`) or a 2.5 in one (`--quick`), m = 3, the energy surface
+/// correction; the reinforced ones (4.2, 4.4) with three steel bars along the tension face. As
+/// in the thesis, the load is ramped in an explicit dynamic run.
+///
+/// Plain beams: the run stops when the crack has run, i.e. when about as many bonds have
+/// broken as cross a quarter of the section, and the load at that step is the measured
+/// strength. The first bonds break earlier, at the supports' corners (validation/README.md),
+/// and are not the beam's cracking. Reinforced beams: the bars hold the beam together after
+/// the first cracks, so the strength is the load at which the beam collapses: the first
+/// history row where the deflection passes ten times the uncracked beam's elastic deflection
+/// under the reference load.
 struct ConcreteBeam {
     dx: f64,
     length: f64,
+    bars: Option<Bars>,
+}
+
+/// The reinforcement of 4.2 and 4.4: three bars of equal area ρ·b·d/3 at y = b/4, b/2, 3b/4,
+/// at effective depth d = 46.5 in from the compression face, the whole length of the beam.
+#[derive(Clone, Copy)]
+struct Bars {
+    ratio: f64,
+    /// Tension at the top (a cantilever's hogging moment) rather than at the bottom.
+    top: bool,
 }
 
 /// Section of the thesis's beams: 30 in wide (y), 50 in deep (z).
@@ -438,20 +539,32 @@ const CONCRETE_WIDTH: f64 = 30.0;
 const CONCRETE_DEPTH: f64 = 50.0;
 /// The thesis's concrete modulus, 3605 ksi (= 57,000√f'c psi), in psi.
 const CONCRETE_E: f64 = 3.605e6;
+/// Effective depth of the reinforced beams' bars.
+const BAR_DEPTH: f64 = 46.5;
+/// The deflection at which a reinforced beam counts as collapsed, in units of the uncracked
+/// elastic deflection under the reference load.
+const COLLAPSE_DEFLECTION: f64 = 10.0;
+/// The reinforced beams' load ramp ends at this multiple of the reference.
+const RC_PEAK: f64 = 2.0;
 
 impl ConcreteBeam {
-    fn new(level: Level, length: f64) -> ConcreteBeam {
+    fn new(level: Level, length: f64, bars: Option<Bars>) -> ConcreteBeam {
         // 2.5 in divides 200, 250, 30 and 50 in.
         let dx = match level {
             Level::Quick => 2.5,
             Level::Full => 1.0,
         };
-        ConcreteBeam { dx, length }
+        ConcreteBeam { dx, length, bars }
     }
 
     /// f_r = 7.5√f'c with f'c = 4000 psi.
     fn rupture_modulus() -> f64 {
         7.5 * 4000f64.sqrt()
+    }
+
+    /// ACI 318-11 Eq. 11-3: V_c = 2√f'c·b·d, normalweight concrete.
+    fn shear_strength() -> f64 {
+        2.0 * 4000f64.sqrt() * CONCRETE_WIDTH * BAR_DEPTH
     }
 
     /// I of the section.
@@ -472,13 +585,22 @@ impl ConcreteBeam {
         (per_area * CONCRETE_WIDTH * CONCRETE_DEPTH / (4.0 * self.dx * self.dx)).ceil() as u64
     }
 
-    /// The deck through the model, material, box, time and output; the caller adds the
-    /// supports, the load (named `load`, with [`ConcreteBeam::ramp`]) and a probe `tip`.
+    /// The deck through the model, materials, box, bars, time and output; the caller adds
+    /// the supports, the load (named `load`, with [`ConcreteBeam::ramp`]) and a probe `tip`.
     fn deck_head(&self, title: &str, ramp_time: f64) -> String {
         let (dx, length) = (self.dx, self.length);
-        let stop = self.crack_bonds();
+        // A plain beam's run stops at its crack count; a reinforced one at its collapse, by its
+        // probe (`stop_beyond`, added by the caller).
+        let (kind, stop, steel) = match self.bars {
+            None => (
+                "plain",
+                format!("stop_at_broken_bonds = {}\n", self.crack_bonds()),
+                String::new(),
+            ),
+            Some(bars) => ("reinforced", String::new(), bars.deck(length)),
+        };
         format!(
-            r#"title = "validation: plain concrete {title} (thesis), {dx} in lattice"
+            r#"title = "validation: {kind} concrete {title} (thesis), {dx} in lattice"
 units = "in-lbf-s"
 [model]
 name = "concrete"
@@ -494,15 +616,14 @@ poisson_ratio = 0.25
 tensile_stretch = 1.387e-4
 compressive_stretch = -1.1e-3
 compressive_strength = "4000 psi"
-[[geometry]]
+{steel}[[geometry]]
 shape = "box"
 material = "concrete"
 min = "0 0 0 in"
 max = "{length} {CONCRETE_WIDTH} {CONCRETE_DEPTH} in"
 [time]
 duration = "{ramp_time} s"
-stop_at_broken_bonds = {stop}
-[output]
+{stop}[output]
 progress = false
 history_every = 20
 frames_every = 100000000
@@ -510,14 +631,25 @@ frames_every = 100000000
         )
     }
 
-    /// The load history: from 0 to 1.3 × the reference over `t` seconds, starting with zero
-    /// slope (a quarter cosine over the first fifth, then straight on with the same slope), so
-    /// that the ramp leaves little vibration in the beam.
-    fn ramp(t: f64) -> String {
+    /// How far the load is ramped, in units of the reference: a plain beam's run stops at its
+    /// failure; a reinforced beam may stand well above ACI's V_c, a lower bound of shear tests.
+    fn peak(&self) -> f64 {
+        if self.bars.is_some() {
+            RC_PEAK
+        } else {
+            1.3
+        }
+    }
+
+    /// The load history: from 0 to [`ConcreteBeam::peak`] × the reference over `t` seconds,
+    /// starting with zero slope (a quarter cosine over the first fifth, then straight on with
+    /// the same slope), so that the ramp leaves little vibration in the beam.
+    fn ramp(&self, t: f64) -> String {
+        let peak = self.peak();
         let t1 = 0.2 * t;
         let half_pi = std::f64::consts::FRAC_PI_2;
-        // f = a(1 − cos(π t'/2 t1)) to t1, then a + a π/(2 t1)(t' − t1); f(t) = 1.3.
-        let a = 1.3 / (1.0 + half_pi * (t - t1) / t1);
+        // f = a(1 − cos(π t'/2 t1)) to t1, then a + a π/(2 t1)(t' − t1); f(t) = peak.
+        let a = peak / (1.0 + half_pi * (t - t1) / t1);
         let mut points: Vec<String> = (0..=12)
             .map(|k| {
                 let tk = t1 * k as f64 / 12.0;
@@ -525,8 +657,37 @@ frames_every = 100000000
                 format!("[\"{tk:.6e} s\", {f:.6e}]")
             })
             .collect();
-        points.push(format!("[\"{t:.6e} s\", 1.3]"));
+        points.push(format!("[\"{t:.6e} s\", {peak}]"));
         format!("history = {{ table = [{}] }}", points.join(", "))
+    }
+}
+
+impl Bars {
+    /// Area of one of the three bars, ρ·b·d/3.
+    fn area(&self) -> f64 {
+        self.ratio * CONCRETE_WIDTH * BAR_DEPTH / 3.0
+    }
+
+    /// The thesis's steel (E = 29,000 ksi, ν = 0.3, 490 lb/ft³, yield strain 0.01) and the three
+    /// bars, as deck text.
+    fn deck(&self, length: f64) -> String {
+        let z = if self.top {
+            BAR_DEPTH
+        } else {
+            CONCRETE_DEPTH - BAR_DEPTH
+        };
+        let mut s = String::from(
+            "[materials.steel]\nkind = \"steel\"\ndensity = \"490 lb/ft^3\"\nyoungs_modulus = \"29000 ksi\"\npoisson_ratio = 0.3\nyield_stretch = 0.01\n",
+        );
+        for k in 1..=3 {
+            let y = CONCRETE_WIDTH * k as f64 / 4.0;
+            let _ = write!(
+                s,
+                "[[bar]]\nmaterial = \"steel\"\narea = \"{:.4} in^2\"\nfrom = \"0 {y} {z} in\"\nto = \"{length} {y} {z} in\"\n",
+                self.area()
+            );
+        }
+        s
     }
 }
 
@@ -542,6 +703,26 @@ fn failure_load(summary: &Summary, dir: &Path) -> Result<f64, String> {
     last_of(dir, "load_load")
 }
 
+/// The applied load at the step where the probe `tip` moved beyond `limit` (its `stop_beyond`,
+/// which ended the run), or an error when the beam stood the whole ramp.
+fn collapse_load(summary: &Summary, dir: &Path, limit: f64) -> Result<f64, String> {
+    if summary.stopped_at_probe.as_deref() == Some("tip") {
+        return last_of(dir, "load_load");
+    }
+    Err(format!(
+        "the beam did not collapse within the ramp (to {RC_PEAK} × the reference): its deflection stayed below {limit:.4} in"
+    ))
+}
+
+/// The `tip` probe's stop at the collapse deflection of a reinforced beam, as deck text.
+fn stop_beyond(reinforced: bool, limit: f64) -> String {
+    if reinforced {
+        format!("stop_beyond = \"{limit} in\"\n")
+    } else {
+        String::new()
+    }
+}
+
 /// (deflection at the probe named `tip`, applied load) over the history rows.
 fn load_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
     let (header, rows) = read_history(dir)?;
@@ -550,15 +731,26 @@ fn load_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
     Ok(rows.iter().map(|r| (-r[uz], r[load])).collect())
 }
 
-/// Thesis problem 4.1: plain concrete cantilever, 200 × 30 × 50 in, clamped over its first
-/// three lattice planes, a downward end load on its last two; first cracking against beam
-/// theory, P = f_r (I/c)/L with L from the clamp face to the load's centre.
-fn concrete_cantilever(level: Level) -> Case {
-    let beam = ConcreteBeam::new(level, 200.0);
+/// Thesis problems 4.1 and 4.2: a concrete cantilever, 200 × 30 × 50 in, clamped over its
+/// first three lattice planes, a downward end load on its last two. Plain (4.1): first
+/// cracking against beam theory, P = f_r (I/c)/L with L from the clamp face to the load's
+/// centre. Reinforced (4.2, ρ = 0.014 at the top): collapse against ACI V_c = 2√f'c·b·d.
+fn concrete_cantilever(level: Level, reinforced: bool) -> Case {
+    let bars = reinforced.then_some(Bars {
+        ratio: 0.014,
+        top: true,
+    });
+    let beam = ConcreteBeam::new(level, 200.0, bars);
     let dx = beam.dx;
     let arm = (beam.length - dx) - 3.0 * dx;
-    let reference = ConcreteBeam::rupture_modulus() * ConcreteBeam::section_modulus() / arm;
+    let reference = if reinforced {
+        ConcreteBeam::shear_strength()
+    } else {
+        ConcreteBeam::rupture_modulus() * ConcreteBeam::section_modulus() / arm
+    };
     let elastic_tip = reference * arm.powi(3) / (3.0 * CONCRETE_E * ConcreteBeam::inertia());
+    let limit = COLLAPSE_DEFLECTION * elastic_tip;
+    let ramp_time = 0.3;
     let deck = format!(
         r#"{head}[[boundary]]
 name = "clamp"
@@ -572,51 +764,85 @@ total_force = "0 0 -{reference} lbf"
 [[probe]]
 name = "tip"
 at = "{length} {y} {z} in"
-"#,
-        head = beam.deck_head("cantilever, end load", 0.3),
-        ramp = ConcreteBeam::ramp(0.3),
+{stop}"#,
+        stop = stop_beyond(reinforced, limit),
+        head = beam.deck_head("cantilever, end load", ramp_time),
+        ramp = beam.ramp(ramp_time),
         clamp_to = 3.0 * dx,
         load_from = beam.length - 2.0 * dx,
         length = beam.length,
         y = CONCRETE_WIDTH / 2.0,
         z = CONCRETE_DEPTH / 2.0,
     );
+    let (name, quantity, thesis, formula, extract): (_, _, _, _, Extractor) = if reinforced {
+        (
+            "concrete_rc_cantilever",
+            format!("strength (load when the tip deflection passes {limit:.2} in)"),
+            180_000.0,
+            format!(
+                "ACI 318-11 Eq. 11-3 V_c = 2√f'c·b·d = {reference:.0} lbf (f'c = 4000 psi, b = {CONCRETE_WIDTH} in, d = {BAR_DEPTH} in), three bars of {:.2} in² (ρ = 0.014) at the top; collapse: the tip deflection passes {COLLAPSE_DEFLECTION} × the uncracked elastic deflection under V_c; thesis 4.2: 180 kips",
+                bars.map_or(0.0, |b| b.area())
+            ),
+            Box::new(move |summary, dir| collapse_load(summary, dir, limit)),
+        )
+    } else {
+        (
+            "concrete_cantilever",
+            "strength (load when the crack has run)".to_string(),
+            30_000.0,
+            format!(
+                "beam theory P = f_r·(I/c)/L, f_r = 7.5√f'c = {:.1} psi (f'c = 4000 psi), I/c = {:.0} in³, L = {arm} in (clamp face to the load's centre); thesis 4.1: \"approaches 30 kips\" (its formula, with L = 200 in: 29.6 kips)",
+                ConcreteBeam::rupture_modulus(),
+                ConcreteBeam::section_modulus()
+            ),
+            Box::new(failure_load),
+        )
+    };
+    let reach = if reinforced { limit } else { 1.3 * elastic_tip };
     Case {
-        name: "concrete_cantilever".into(),
-        quantity: "strength (load when the crack has run)".into(),
+        name: name.into(),
+        quantity,
         unit: "lbf",
         kind: Kind::Strength,
         reference,
-        thesis: Some(30_000.0),
-        formula: format!(
-            "beam theory P = f_r·(I/c)/L, f_r = 7.5√f'c = {:.1} psi (f'c = 4000 psi), I/c = {:.0} in³, L = {arm} in (clamp face to the load's centre); thesis 4.1: \"approaches 30 kips\" (its formula, with L = 200 in: 29.6 kips)",
-            ConcreteBeam::rupture_modulus(),
-            ConcreteBeam::section_modulus()
-        ),
+        thesis: Some(thesis),
+        formula,
         tolerance_percent: 15.0,
         deck,
-        extract: failure_load,
+        extract,
+        damage_views: true,
         plot: Some(Plot {
             x_label: "tip deflection (in)".into(),
             y_label: "end load (lbf)".into(),
-            reference: vec![(0.0, reference), (1.3 * elastic_tip, reference)],
+            reference: vec![(0.0, reference), (reach, reference)],
             measured: load_deflection,
         }),
     }
 }
 
-/// Thesis problem 4.3: plain concrete beam, 250 × 30 × 50 in, on line supports under its end
-/// planes' bottom rows (pin and roller), a uniform load on its top two layers; first cracking
-/// against beam theory, w = 8 f_r (I/c)/L² with L between the support lines.
-fn concrete_simply_supported(level: Level) -> Case {
-    let beam = ConcreteBeam::new(level, 250.0);
+/// Thesis problems 4.3 and 4.4: a concrete beam, 250 × 30 × 50 in, on line supports under its
+/// end planes' bottom rows (pin and roller), a uniform load on its top two layers. Plain (4.3):
+/// first cracking against beam theory, w = 8 f_r (I/c)/L² with L between the support lines.
+/// Reinforced (4.4, ρ = 0.01 at the bottom): collapse against w = 2 V_c/L, the load whose end
+/// shear is ACI's V_c.
+fn concrete_simply_supported(level: Level, reinforced: bool) -> Case {
+    let bars = reinforced.then_some(Bars {
+        ratio: 0.01,
+        top: false,
+    });
+    let beam = ConcreteBeam::new(level, 250.0, bars);
     let dx = beam.dx;
     let span = beam.length - dx;
-    let reference =
-        8.0 * ConcreteBeam::rupture_modulus() * ConcreteBeam::section_modulus() / (span * span);
+    let reference = if reinforced {
+        2.0 * ConcreteBeam::shear_strength() / span
+    } else {
+        8.0 * ConcreteBeam::rupture_modulus() * ConcreteBeam::section_modulus() / (span * span)
+    };
     let elastic_mid =
         5.0 * reference * span.powi(4) / (384.0 * CONCRETE_E * ConcreteBeam::inertia());
+    let limit = COLLAPSE_DEFLECTION * elastic_mid;
     let total = reference * beam.length;
+    let ramp_time = if reinforced { 0.3 } else { 0.2 };
     let deck = format!(
         r#"{head}{supports}[[load]]
 name = "load"
@@ -626,9 +852,10 @@ total_force = "0 0 -{total} lbf"
 [[probe]]
 name = "tip"
 at = "{mid_x} {y} 0 in"
-"#,
-        head = beam.deck_head("simply supported beam, uniform load", 0.2),
-        ramp = ConcreteBeam::ramp(0.2),
+{stop}"#,
+        stop = stop_beyond(reinforced, limit),
+        head = beam.deck_head("simply supported beam, uniform load", ramp_time),
+        ramp = beam.ramp(ramp_time),
         w = CONCRETE_WIDTH,
         d = CONCRETE_DEPTH,
         length = beam.length,
@@ -637,26 +864,50 @@ at = "{mid_x} {y} 0 in"
         mid_x = beam.length / 2.0,
         y = CONCRETE_WIDTH / 2.0,
     );
+    // The history's load is the total over the beam's length; per length of beam.
+    let length = beam.length;
+    let (name, quantity, thesis, formula, extract): (_, _, _, _, Extractor) = if reinforced {
+        (
+            "concrete_rc_simply_supported",
+            format!("strength per length (load when the midspan deflection passes {limit:.3} in)"),
+            1300.0,
+            format!(
+                "w = 2·V_c/L with ACI 318-11 Eq. 11-3 V_c = 2√f'c·b·d = {:.0} lbf (f'c = 4000 psi, b = {CONCRETE_WIDTH} in, d = {BAR_DEPTH} in), L = {span} in between the support lines; three bars of {:.2} in² (ρ = 0.01) at the bottom; collapse: the midspan deflection passes {COLLAPSE_DEFLECTION} × the uncracked elastic deflection under the reference load; thesis 4.4: about 1300 lb/in",
+                ConcreteBeam::shear_strength(),
+                bars.map_or(0.0, |b| b.area())
+            ),
+            Box::new(move |summary, dir| Ok(collapse_load(summary, dir, limit)? / length)),
+        )
+    } else {
+        (
+            "concrete_simply_supported",
+            "strength per length (load when the crack has run)".to_string(),
+            765.0,
+            format!(
+                "beam theory w = 8·f_r·(I/c)/L², f_r = 7.5√f'c = {:.1} psi, I/c = {:.0} in³, L = {span} in between the support lines; thesis 4.3: sudden failure at 765 lb/in (its formula, with L = 250 in: 760 lb/in)",
+                ConcreteBeam::rupture_modulus(),
+                ConcreteBeam::section_modulus()
+            ),
+            Box::new(move |summary, dir| Ok(failure_load(summary, dir)? / length)),
+        )
+    };
+    let reach = if reinforced { limit } else { 1.3 * elastic_mid };
     Case {
-        name: "concrete_simply_supported".into(),
-        quantity: "strength per length (load when the crack has run)".into(),
+        name: name.into(),
+        quantity,
         unit: "lbf/in",
         kind: Kind::Strength,
         reference,
-        thesis: Some(765.0),
-        formula: format!(
-            "beam theory w = 8·f_r·(I/c)/L², f_r = 7.5√f'c = {:.1} psi, I/c = {:.0} in³, L = {span} in between the support lines; thesis 4.3: sudden failure at 765 lb/in (its formula, with L = 250 in: 760 lb/in)",
-            ConcreteBeam::rupture_modulus(),
-            ConcreteBeam::section_modulus()
-        ),
+        thesis: Some(thesis),
+        formula,
         tolerance_percent: 15.0,
         deck,
-        // The history's load is the total over the 250 in; per length of beam.
-        extract: |summary, dir| Ok(failure_load(summary, dir)? / 250.0),
+        extract,
+        damage_views: true,
         plot: Some(Plot {
             x_label: "midspan deflection of the bottom (in)".into(),
             y_label: "total load (lbf)".into(),
-            reference: vec![(0.0, total), (1.3 * elastic_mid, total)],
+            reference: vec![(0.0, total), (reach, total)],
             measured: load_deflection,
         }),
     }
@@ -667,8 +918,10 @@ pub fn cases(level: Level) -> Vec<Case> {
     let models = ["pmb", "lps", "micropolar"];
     let mut all: Vec<Case> = models.iter().map(|m| cantilever(m, level)).collect();
     all.extend(models.iter().map(|m| simply_supported(m, level)));
-    all.push(concrete_cantilever(level));
-    all.push(concrete_simply_supported(level));
+    for reinforced in [false, true] {
+        all.push(concrete_cantilever(level, reinforced));
+        all.push(concrete_simply_supported(level, reinforced));
+    }
     all
 }
 
@@ -720,6 +973,17 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
         }
         None => None,
     };
+    let views = if case.damage_views {
+        let path = dir.with_file_name(format!("{}_damage.png", case.name));
+        draw_damage_views(
+            dir,
+            &path,
+            &format!("{}: damage at {:.4e} {}", case.name, measured, case.unit),
+        )?;
+        Some(path)
+    } else {
+        None
+    };
     Ok(Outcome {
         name: case.name.clone(),
         quantity: case.quantity.clone(),
@@ -736,6 +1000,7 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
         seconds,
         passed,
         plot,
+        views,
     })
 }
 
@@ -854,7 +1119,7 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
         let _ = writeln!(report, "- `{}`: {}", o.name, o.formula);
     }
     for o in &outcomes {
-        if let Some(p) = &o.plot {
+        for p in o.plot.iter().chain(&o.views) {
             let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
             let _ = writeln!(report, "\n![{}]({name})", o.name);
         }

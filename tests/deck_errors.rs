@@ -727,3 +727,17 @@ fn stop_at_zero_broken_bonds() {
     let deck = edit("steps = 10\n", "steps = 10\nstop_at_broken_bonds = 0\n");
     assert_rejected("stop_zero", &deck, &["stop_at_broken_bonds", ">= 1"], None);
 }
+
+/// A probe's stop distance must be a positive length: a negative one would stop at once.
+#[test]
+fn a_probe_stop_of_negative_length() {
+    let deck =
+        format!("{BASE}\n[[probe]]\nname = \"tip\"\nat = \"3 3 6 mm\"\nstop_beyond = \"-1 mm\"\n");
+    let line = line_of(&deck, "[[probe]]");
+    assert_rejected(
+        "probe_stop",
+        &deck,
+        &["probe 'tip'", "stop_beyond", "> 0"],
+        Some(line),
+    );
+}

@@ -66,6 +66,55 @@ fn quick_example_runs_and_cracks() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// A probe's `stop_beyond` ends the run at the first history row where the probe has moved
+/// farther than that, with that row and a frame of that step as the last.
+#[test]
+fn a_run_stops_once_a_probe_has_moved_far_enough() {
+    let text = std::fs::read_to_string("inputs/pmb_block.toml")
+        .unwrap()
+        .replace(
+            "at = \"40 5 5 mm\"",
+            "at = \"40 5 5 mm\"\nstop_beyond = \"0.1 mm\"",
+        );
+    let scene = deck::parse(&text, "pmb_block_probe.toml", "pmb_block_probe").unwrap();
+    let dir = std::env::temp_dir().join(format!("pdq-inputs-probe-{}", std::process::id()));
+    let s = run(
+        &scene,
+        &RunOptions {
+            output: Some(dir.clone()),
+            quiet: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(s.stopped_at_probe.as_deref(), Some("tip"));
+    assert!(!s.stopped_at_broken);
+    // The grip pulls at 0.5 m/s: the tip passes 0.1 mm well before the 2000 steps that take
+    // it to 0.22 mm.
+    assert!(
+        s.steps < 2000 && s.steps.is_multiple_of(20),
+        "stopped at step {}",
+        s.steps
+    );
+    let (header, rows) = pdq::validate::read_history(&dir).unwrap();
+    let ux = header.iter().position(|c| c == "tip_ux").unwrap();
+    let step = header.iter().position(|c| c == "step").unwrap();
+    let (last, before) = (&rows[rows.len() - 1], &rows[rows.len() - 2]);
+    assert_eq!(
+        last[step] as u64, s.steps,
+        "the stop step's row is the last"
+    );
+    assert!(
+        last[ux] > 1e-4 && before[ux] <= 1e-4,
+        "{} then {}",
+        before[ux],
+        last[ux]
+    );
+    let frame = dir.join(format!("frames/frame_{:08}.h5", s.steps));
+    assert!(frame.exists(), "{} is written", frame.display());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
 /// `[time] stop_at_broken_bonds` ends the run at the first step with that many broken bonds,
 /// with that step's history row as the last, and says so in the summary.
 #[test]

@@ -77,7 +77,8 @@ history_every = 1
             formula: "none".into(),
             tolerance_percent: 2.0,
             deck: deck.into(),
-            extract: |_, dir| validate::last_of(dir, "tip_ux"),
+            extract: Box::new(|_, dir| validate::last_of(dir, "tip_ux")),
+            damage_views: false,
             plot: None,
         },
         &dir,
@@ -96,7 +97,8 @@ history_every = 1
         formula: "twice the answer".into(),
         tolerance_percent: 2.0,
         deck: deck.into(),
-        extract: |_, dir| validate::last_of(dir, "tip_ux"),
+        extract: Box::new(|_, dir| validate::last_of(dir, "tip_ux")),
+        damage_views: false,
         plot: None,
     };
     let o = validate::run_case(&case, &dir, 1).unwrap();
@@ -108,14 +110,25 @@ history_every = 1
         "{table}"
     );
     // A strength case outside its tolerance is reported, not failed, with the thesis's value
-    // as a second reference.
+    // as a second reference, and with its damage picture when asked for one.
     let strength = Case {
         kind: Kind::Strength,
         thesis: Some(measured),
+        damage_views: true,
+        deck: deck.replace("history_every = 1", "history_every = 1\nframes_every = 1"),
         ..case
     };
     let o = validate::run_case(&strength, &dir, 1).unwrap();
     assert!(!o.passed);
+    let views = o.views.clone().expect("a damage picture");
+    let decoder = png::Decoder::new(std::fs::File::open(&views).unwrap());
+    let info = decoder.read_info().unwrap().info().clone();
+    assert_eq!(
+        (info.width, info.height),
+        (1200, 960),
+        "{}",
+        views.display()
+    );
     let table = validate::table(&[o]);
     assert!(
         table.contains("outside") && table.contains("(+0.00 %)"),
