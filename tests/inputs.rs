@@ -66,6 +66,22 @@ fn quick_example_runs_and_cracks() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// Runs a variant of the example deck, quietly, into a fresh temporary directory.
+fn run_variant(text: &str, name: &str) -> (pdq::run::Summary, std::path::PathBuf) {
+    let scene = deck::parse(text, &format!("pmb_block_{name}.toml"), name).unwrap();
+    let dir = std::env::temp_dir().join(format!("pdq-inputs-{name}-{}", std::process::id()));
+    let s = run(
+        &scene,
+        &RunOptions {
+            output: Some(dir.clone()),
+            quiet: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    (s, dir)
+}
+
 /// A probe's `stop_beyond` ends the run at the first history row where the probe has moved
 /// farther than that, with that row and a frame of that step as the last.
 #[test]
@@ -76,17 +92,7 @@ fn a_run_stops_once_a_probe_has_moved_far_enough() {
             "at = \"40 5 5 mm\"",
             "at = \"40 5 5 mm\"\nstop_beyond = \"0.1 mm\"",
         );
-    let scene = deck::parse(&text, "pmb_block_probe.toml", "pmb_block_probe").unwrap();
-    let dir = std::env::temp_dir().join(format!("pdq-inputs-probe-{}", std::process::id()));
-    let s = run(
-        &scene,
-        &RunOptions {
-            output: Some(dir.clone()),
-            quiet: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let (s, dir) = run_variant(&text, "probe");
     assert_eq!(s.stopped_at_probe.as_deref(), Some("tip"));
     assert!(!s.stopped_at_broken);
     // The grip pulls at 0.5 m/s: the tip passes 0.1 mm well before the 2000 steps that take
@@ -122,17 +128,7 @@ fn a_run_stops_once_enough_bonds_have_broken() {
     let text = std::fs::read_to_string("inputs/pmb_block.toml")
         .unwrap()
         .replace("[time]\n", "[time]\nstop_at_broken_bonds = 40\n");
-    let scene = deck::parse(&text, "pmb_block_stop.toml", "pmb_block_stop").unwrap();
-    let dir = std::env::temp_dir().join(format!("pdq-inputs-stop-{}", std::process::id()));
-    let s = run(
-        &scene,
-        &RunOptions {
-            output: Some(dir.clone()),
-            quiet: true,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let (s, dir) = run_variant(&text, "stop");
     assert!(s.stopped_at_broken, "the run must stop early");
     assert!(
         s.broken >= 40 && s.steps < 2000,
