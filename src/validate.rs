@@ -399,17 +399,22 @@ struct Frame {
 /// The last frame of the run in `dir`.
 fn last_frame(dir: &Path) -> Result<Frame, String> {
     let frames = dir.join("frames");
-    // Frame files are named by their zero-padded step, so name order is step order.
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&frames)
+    // Frame files are named frame_<step>.h5; the step is zero-padded to 8 digits only.
+    let step_of = |p: &PathBuf| {
+        p.file_stem()
+            .and_then(|s| s.to_str())
+            .and_then(|s| s.strip_prefix("frame_"))
+            .and_then(|s| s.parse::<u64>().ok())
+    };
+    let last = std::fs::read_dir(&frames)
         .map_err(|e| format!("{}: {e}", frames.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "h5"))
-        .collect();
-    files.sort();
-    let last = files
-        .last()
+        .filter_map(|p| step_of(&p).map(|s| (s, p)))
+        .max_by_key(|(s, _)| *s)
+        .map(|(_, p)| p)
         .ok_or_else(|| format!("{}: no frames", frames.display()))?;
-    let f = hdf5_pure::File::open(last).map_err(|e| format!("{}: {e}", last.display()))?;
+    let f = hdf5_pure::File::open(&last).map_err(|e| format!("{}: {e}", last.display()))?;
     let read = |name: &str| {
         f.dataset(name)
             .and_then(|d| d.read_f64())
@@ -458,7 +463,10 @@ fn draw_damage_views(dir: &Path, path: &Path, title: &str) -> Result<(), String>
     // Lattice particles fill a cube of their volume; bar particles are drawn at that size too.
     let mut volumes = frame.volume.clone();
     volumes.sort_by(f64::total_cmp);
-    let spacing = volumes[volumes.len() / 2].cbrt();
+    let spacing = volumes
+        .get(volumes.len() / 2)
+        .ok_or_else(|| format!("{}: the last frame has no particles", dir.display()))?
+        .cbrt();
     crate::plot::damage_views(
         path,
         &format!("{title}; displacements × {magnify:.1}"),
@@ -965,14 +973,20 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
         }
         None => None,
     };
+    // A picture that cannot be drawn is reported, not allowed to lose the measured value.
     let views = if case.damage_views {
         let path = dir.with_file_name(format!("{}_damage.png", case.name));
-        draw_damage_views(
+        match draw_damage_views(
             dir,
             &path,
             &format!("{}: damage at {:.4e} {}", case.name, measured, case.unit),
-        )?;
-        Some(path)
+        ) {
+            Ok(()) => Some(path),
+            Err(e) => {
+                eprintln!("warning: case {}: no damage picture: {e}", case.name);
+                None
+            }
+        }
     } else {
         None
     };

@@ -116,8 +116,12 @@ fn a_run_stops_once_a_probe_has_moved_far_enough() {
         before[ux],
         last[ux]
     );
-    let frame = dir.join(format!("frames/frame_{:08}.h5", s.steps));
-    assert!(frame.exists(), "{} is written", frame.display());
+    for file in [
+        format!("frames/frame_{:08}.h5", s.steps),
+        format!("checkpoints/checkpoint_{:08}.h5", s.steps),
+    ] {
+        assert!(dir.join(&file).exists(), "{file} is written at the stop");
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }
 

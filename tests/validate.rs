@@ -171,3 +171,30 @@ fn the_sweep_reports_error_against_run_time() {
     assert!(e.contains("odd"), "{e}");
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// Every case's deck, at both levels, is a valid deck (the long ones are not run in the test
+/// suite); the reinforced beams have their three bars and stop at their collapse.
+#[test]
+fn every_case_deck_parses() {
+    for level in [Level::Quick, Level::Full] {
+        for case in validate::cases(level) {
+            let name = format!("{}.toml", case.name);
+            if let Err(e) = pdq::deck::parse(&case.deck, &name, &case.name) {
+                panic!("{:?} {}: {e}", level, case.name);
+            }
+            let reinforced = case.name.starts_with("concrete_rc_");
+            assert_eq!(
+                case.deck.matches("[[bar]]").count(),
+                if reinforced { 3 } else { 0 },
+                "{}",
+                case.name
+            );
+            assert_eq!(
+                case.deck.contains("stop_beyond"),
+                reinforced,
+                "{}",
+                case.name
+            );
+        }
+    }
+}
