@@ -367,7 +367,6 @@ struct Plan {
     shuffle_every: u64,
     /// `[time] stop_at_broken_bonds` (0 = off).
     stop_at_broken: u64,
-    n_probes: usize,
     /// Each probe's name and `stop_beyond` (infinite when not given), in deck order.
     probe_stops: Vec<(String, f64)>,
     layout: String,
@@ -527,10 +526,11 @@ fn drive<M: Model>(
             let damage = cube.damage();
             let mut probe_halt = None;
             if want_row {
-                let mut r = row(&mut cube, &damage, plan.n_probes);
+                let n_probes = plan.probe_stops.len();
+                let mut r = row(&mut cube, &damage, n_probes);
                 // The probes' displacements end the row (before the residual); every worker
                 // has the whole row, so all stop alike.
-                let first_probe = r.len() - 1 - 3 * plan.n_probes;
+                let first_probe = r.len() - 1 - 3 * n_probes;
                 probe_halt = plan
                     .probe_stops
                     .iter()
@@ -907,7 +907,6 @@ fn run_setup<M: Model>(
         final_state: scene.output.final_state,
         shuffle_every: scene.parallel.shuffle_every,
         stop_at_broken: scene.time.stop_at_broken_bonds,
-        n_probes: setup.probes.len(),
         probe_stops: scene
             .probes
             .iter()
