@@ -11,6 +11,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+mod lap_splice;
+
 /// The resolution of a validation run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Level {
@@ -944,6 +946,9 @@ pub fn cases(level: Level) -> Vec<Case> {
     for reinforced in [false, true] {
         all.push(concrete_cantilever(level, reinforced));
         all.push(concrete_simply_supported(level, reinforced));
+    }
+    for (suffix, velocity) in lap_splice::VELOCITIES {
+        all.push(lap_splice::lap_splice(level, suffix, velocity));
     }
     all
 }
