@@ -201,3 +201,30 @@ fn every_case_deck_parses() {
         }
     }
 }
+
+/// The fastest lap-splice pullout runs end to end: its grips and probes exist under the names
+/// the extractor reads, the bars carry a pull that peaks and falls (the splice fails within
+/// the run), and the damage picture is drawn.
+#[test]
+fn the_fast_lap_splice_pulls_out() {
+    let case = validate::cases(Level::Quick)
+        .into_iter()
+        .find(|c| c.name == "lap_splice_fast")
+        .expect("the case exists");
+    let dir = out("lap");
+    let o = validate::run_case(&case, &dir.join(&case.name), 1).expect("the case runs");
+    assert!(o.measured.is_finite() && o.measured > 0.0, "{}", o.measured);
+    let (header, rows) = validate::read_history(&dir.join(&case.name)).unwrap();
+    let force = header
+        .iter()
+        .position(|h| h == "reaction_right_grip_x")
+        .unwrap();
+    let last = rows.last().unwrap()[force];
+    assert!(
+        last < 0.5 * o.measured,
+        "the pull {last} has not fallen from {}",
+        o.measured
+    );
+    assert!(o.views.as_deref().is_some_and(Path::exists));
+    let _ = std::fs::remove_dir_all(dir);
+}
