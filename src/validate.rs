@@ -144,9 +144,9 @@ struct Beam {
 const ELASTIC_TOLERANCE_FULL: f64 = 2.0;
 
 /// At `--quick` the section has 7 planes, so with δ = 3 dx every particle but the axis row is
-/// within a horizon of a face and the models' surface effects are several per cent (validation/README.md). The
-/// gate there is 10 %: it catches a broken model, solver or reference, not the last per cent,
-/// which `--full` is held to.
+/// within a horizon of a face and the models' surface effects are several per cent
+/// (validation/README.md). The gate there is 10 %: it catches a broken model, solver or
+/// reference, not the last per cent, which `--full` is held to.
 const ELASTIC_TOLERANCE_QUICK: f64 = 10.0;
 
 impl Beam {

@@ -39,6 +39,10 @@ const BAR_OFFSET: f64 = 1.0;
 /// The thesis's concrete modulus for this problem, 3504 ksi, in psi; f'c follows from ACI
 /// 318-11 §8.5.1, E = 57,000√f'c, as the thesis states no compressive strength for it.
 const SPLICE_CONCRETE_E: f64 = 3.504e6;
+/// The thesis's concrete tensile strength and steel for this problem (psi).
+const SPLICE_CONCRETE_TENSILE: f64 = 600.0;
+const STEEL_E: f64 = 29.0e6;
+const STEEL_YIELD: f64 = 150.0e3;
 /// The run goes on until each bar end has moved this far (in), well past the peak force.
 const END_TRAVEL: f64 = 0.015;
 
@@ -97,14 +101,14 @@ origin = "0 -{half} -{half} in"
 [materials.concrete]
 kind = "concrete"
 density = "2400 kg/m^3"
-youngs_modulus = "3504 ksi"
+youngs_modulus = "{SPLICE_CONCRETE_E} psi"
 poisson_ratio = 0.22
 tensile_stretch = {tensile:.5e}
 compressive_stretch = -1.1e-3
 [materials.steel]
 kind = "steel"
 density = "7850 kg/m^3"
-youngs_modulus = "29000 ksi"
+youngs_modulus = "{STEEL_E} psi"
 poisson_ratio = 0.3
 yield_stretch = {yield_stretch:.5e}
 [[geometry]]
@@ -153,9 +157,8 @@ progress = false
 history_every = 10
 frames_every = 100000000
 "#,
-        // The thesis's tensile strength 0.6 ksi and yield stress 150 ksi as stretches.
-        tensile = 600.0 / SPLICE_CONCRETE_E,
-        yield_stretch = 150.0 / 29_000.0,
+        tensile = SPLICE_CONCRETE_TENSILE / SPLICE_CONCRETE_E,
+        yield_stretch = STEEL_YIELD / STEEL_E,
         left_lo = left_from - dx,
         // Half-open slabs, from ≤ x < to; no bar particle lies on these planes.
         left_hi = -horizon,
