@@ -226,6 +226,21 @@ impl Model for Concrete {
         bond_based_lame(own.stiffness(), self.delta)
     }
 
+    fn prestrained(&self, law: &Law, strain: f64) -> Result<PlasticStretch, String> {
+        match *law {
+            // Elastic stretch = s − plastic, so a plastic stretch of −ε holds the bond at +ε.
+            Law::Plastic { yield_, .. } if strain.abs() < yield_ => Ok(PlasticStretch {
+                plastic_stretch: -strain,
+            }),
+            Law::Plastic { yield_, .. } => Err(format!(
+                "prestrain {strain} is not below the bar's yield stretch {yield_}: it would yield at once"
+            )),
+            Law::Brittle { .. } => {
+                Err("only a bar of kind \"steel\" can be prestrained (its bonds keep a plastic stretch)".into())
+            }
+        }
+    }
+
     #[inline(always)]
     fn pair(
         &self,

@@ -209,6 +209,8 @@ struct BarSection {
     elevation: Option<f64>,
     length: Option<Length>,
     spacing: Option<Length>,
+    prestrain: Option<f64>,
+    prestress: Option<Stress>,
 }
 
 #[derive(Deserialize)]
@@ -468,6 +470,8 @@ pub struct Scene {
     pub op_lines: Vec<usize>,
     pub bars: Vec<Bar>,
     pub bar_lines: Vec<usize>,
+    /// Initial stretch of each bar's own bonds (0: none); see `bars.rs`.
+    pub bar_prestrain: Vec<f64>,
     pub time: TimeSpec,
     pub boundaries: Vec<BoundarySpec>,
     pub loads: Vec<LoadSpec>,
@@ -726,9 +730,17 @@ impl Converter {
         }
         let mut bars = Vec::new();
         let mut bar_lines = Vec::new();
+        let mut bar_prestrain = Vec::new();
         for (k, b) in deck.bar.iter().enumerate() {
             let line = self.line_of(b);
-            bars.push(self.bar(b.get_ref(), k, line, spacing, &material_id)?);
+            let bar = self.bar(b.get_ref(), k, line, spacing, &material_id)?;
+            bar_prestrain.push(self.prestrain(
+                b.get_ref(),
+                k,
+                line,
+                &materials[bar.material as usize],
+            )?);
+            bars.push(bar);
             bar_lines.push(line);
         }
         if ops.is_empty() && bars.is_empty() {
@@ -1023,6 +1035,7 @@ impl Converter {
             op_lines,
             bars,
             bar_lines,
+            bar_prestrain,
             time: TimeSpec {
                 length,
                 dt,
@@ -1439,6 +1452,40 @@ impl Converter {
             }
         }
         Ok(bar)
+    }
+
+    /// A bar's initial strain, given as `prestrain` or as `prestress` over the material's E.
+    fn prestrain(&self, b: &BarSection, k: usize, line: usize, material: &Material) -> R<f64> {
+        let ctx = format!("bar {k}");
+        let strain = match (b.prestrain, b.prestress) {
+            (None, None) => return Ok(0.0),
+            (Some(e), None) => e,
+            (None, Some(stress)) => match material.youngs_modulus {
+                Some(e) => stress.value(self.sys) / e,
+                None => return self.err(
+                    line,
+                    format!(
+                        "{ctx}: prestress needs youngs_modulus on material '{}'; or give prestrain",
+                        material.name
+                    ),
+                ),
+            },
+            (Some(_), Some(_)) => {
+                return self.err(
+                    line,
+                    format!("{ctx}: give prestrain or prestress, not both"),
+                )
+            }
+        };
+        if !(strain.is_finite() && strain.abs() < 0.1) {
+            return self.err(
+                line,
+                format!(
+                    "{ctx}: prestrain must be a finite strain below 0.1 in size (got {strain})"
+                ),
+            );
+        }
+        Ok(strain)
     }
 
     fn history(&self, h: &Option<HistorySpec>, line: usize, ctx: &str) -> R<History> {

@@ -402,7 +402,7 @@ impl Bar {
         Ok(())
     }
 
-    fn length(&self) -> f64 {
+    pub fn length(&self) -> f64 {
         let d = sub(self.to, self.from);
         dot(d, d).sqrt()
     }
@@ -422,7 +422,12 @@ pub struct Cloud {
     /// realised spacing len/n. Reported for inspection: the engine's partial-volume factor uses
     /// the lattice spacing for every bond, bar bonds included.
     pub spacing: Vec<f64>,
+    /// Index of the bar each particle belongs to, [`NOT_A_BAR`] for lattice particles.
+    pub bar: Vec<u32>,
 }
+
+/// The bar index of a lattice particle.
+pub const NOT_A_BAR: u32 = u32::MAX;
 
 impl Cloud {
     pub fn len(&self) -> usize {
@@ -548,7 +553,7 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
     }
     let mut bar_particles = Vec::new();
     let rm = 0.25 * s;
-    for bar in bars {
+    for (b, bar) in bars.iter().enumerate() {
         let n = bar.count();
         let (step, ds) = (sub(bar.to, bar.from).map(|d| d / n), bar.length() / n);
         for k in 0..n as usize {
@@ -559,16 +564,23 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
                     filled.remove(&key);
                 }
             }
-            bar_particles.push((p, bar.area * ds, bar.material, ds));
+            bar_particles.push((p, bar.area * ds, bar.material, ds, b as u32));
         }
     }
 
     let mut cloud = Cloud::default();
     let lattice_particles = filled.iter().map(|(key, &m)| {
         let (p, d) = (site(key), lattice.offset(key));
-        ([p[0] + d[0], p[1] + d[1], p[2] + d[2]], s * s * s, m, s)
+        (
+            [p[0] + d[0], p[1] + d[1], p[2] + d[2]],
+            s * s * s,
+            m,
+            s,
+            NOT_A_BAR,
+        )
     });
-    for (p, volume, material, spacing) in lattice_particles.chain(bar_particles) {
+    for (p, volume, material, spacing, bar) in lattice_particles.chain(bar_particles) {
+        cloud.bar.push(bar);
         cloud.position.push(p);
         cloud.volume.push(volume);
         cloud.material.push(material);

@@ -6,6 +6,7 @@
 
 pub mod analysis;
 pub mod attributes;
+pub mod bars;
 pub mod bench;
 pub mod bonds;
 pub mod boundary;

@@ -317,6 +317,17 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     /// per unit volume of both ends.
     fn bond_stiffness(&self, law: &Self::Law, geom: &BondGeom) -> Self::Force;
 
+    /// The history of a bond held at an initial stretch `strain` under law `law` (a prestrained
+    /// bar's own bonds, `[[bar]] prestrain`): the bond is unstressed at length (1 − strain)·|ξ|,
+    /// so at its reference length it pulls its ends together with the force of that stretch.
+    /// A model without a history that can hold a rest length refuses, with the reason.
+    fn prestrained(&self, _law: &Self::Law, _strain: f64) -> Result<Self::Bond, String> {
+        Err(format!(
+            "model '{}' cannot prestrain bonds (it keeps no plastic stretch); use model \"concrete\" with a steel bar",
+            Self::NAME
+        ))
+    }
+
     /// Continuum Lamé constants (λ, μ) the model is calibrated to for `material`: the targets
     /// of the energy surface correction and of validation.
     fn lame(&self, material: u16) -> (f64, f64);

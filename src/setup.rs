@@ -2,6 +2,7 @@
 //! → boundary conditions and loads.
 
 use crate::attributes::Attributes;
+use crate::bars::BarBonds;
 use crate::bonds::BondList;
 use crate::boundary::{Constraint, Load, TEMPERATURE};
 use crate::cells::CellGrid;
@@ -32,6 +33,8 @@ pub struct Setup<M: Model> {
     pub correction: Option<Vec<[f64; 3]>>,
     /// Explicit stepping, or relaxation to equilibrium at each load step.
     pub solver: crate::deck::SolverSpec,
+    /// Calibration factors and prestrain of the bars' own bonds.
+    pub bars: BarBonds<M::Bond>,
 }
 
 /// Builds the model named by the deck and hands it to `visitor`.
@@ -148,6 +151,9 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
             ),
         ));
     }
+
+    let bars = bar_bonds(&model, &mut particles, &bonds, scene, cloud.bar)?;
+    bars.apply(&mut bonds, |i| particles.gid[i]);
 
     // Time step.
     let (dt_critical, dt_critical_particle) = stable_time_step(&model, &particles, &bonds);
@@ -355,6 +361,67 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         partial_volume: scene.partial_volume,
         correction,
         solver: scene.solver.clone(),
+        bars,
+    })
+}
+
+/// The bars' calibration factors (bond-based models) and prestrained bond histories; see
+/// `bars.rs`. `bar_of` is by global id.
+fn bar_bonds<M: Model>(
+    model: &M,
+    particles: &mut Particles<M>,
+    bonds: &BondList<M::Bond>,
+    scene: &Scene,
+    bar_of: Vec<u32>,
+) -> Result<BarBonds<M::Bond>, DeckError> {
+    if scene.bars.is_empty() {
+        return Ok(BarBonds {
+            bar_of: Vec::new(),
+            factor: Vec::new(),
+            initial: Vec::new(),
+        });
+    }
+    let modulus: Vec<f64> = scene
+        .bars
+        .iter()
+        .map(|b| {
+            scene.materials[b.material as usize]
+                .youngs_modulus
+                .unwrap_or_else(|| {
+                    let (l, mu) = model.lame(b.material);
+                    mu * (3.0 * l + 2.0 * mu) / (l + mu)
+                })
+        })
+        .collect();
+    let factor = if <M::State as Attributes>::LEN == 0 {
+        crate::bars::calibrate(
+            model,
+            particles,
+            bonds,
+            &scene.bars,
+            &modulus,
+            &bar_of,
+            scene.horizon,
+        )
+    } else {
+        vec![1.0; scene.bars.len()]
+    };
+    let mut initial = Vec::with_capacity(scene.bars.len());
+    for (k, (bar, &strain)) in scene.bars.iter().zip(&scene.bar_prestrain).enumerate() {
+        if strain == 0.0 {
+            initial.push(None);
+            continue;
+        }
+        let law = model.law(bar.material, bar.material);
+        let history = model
+            .prestrained(&law, strain)
+            .map_err(|m| scene.error(Some(scene.bar_lines[k]), format!("bar {k}: {m}")))?;
+        initial.push(Some(history));
+    }
+    Ok(BarBonds {
+        bar_of,
+        factor,
+        initial,
     })
 }
 

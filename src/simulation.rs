@@ -212,11 +212,14 @@ pub fn stiffness_sums<M: Model>(
         let law = model.law(p.material[i], p.material[j]);
         let c = model.bond_stiffness(&law, &bonds.geom[b]);
         let c = c.as_slice();
+        // β ≤ 1 (partial volume) is left out, which errs on the safe side; a calibrated bar bond
+        // (bars.rs) or a surface-corrected one can be stiffer than its law, and counts.
+        let beta = bonds.geom[b].beta.max(1.0);
         for (k, v) in sum[i].as_mut_slice().iter_mut().enumerate() {
-            *v += p.volume[j] * c[k];
+            *v += p.volume[j] * c[k] * beta;
         }
         for (k, v) in sum[j].as_mut_slice().iter_mut().enumerate() {
-            *v += p.volume[i] * c[k];
+            *v += p.volume[i] * c[k] * beta;
         }
     }
     sum
