@@ -23,21 +23,49 @@ use crate::particles::Particles;
 /// The strain of the probing stretch (the bond laws are linear there).
 const PROBE_STRAIN: f64 = 1e-4;
 
+/// A bar's prestrain: `strain` on its own bonds, reached `transfer_length` from either end
+/// and growing linearly from zero at the end over that length (0: in full up to the ends).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Prestrain {
+    pub strain: f64,
+    pub transfer_length: f64,
+}
+
+impl Prestrain {
+    /// The strain of a bond whose midpoint lies `from_end` from the nearer end of its bar.
+    pub fn at(&self, from_end: f64) -> f64 {
+        if self.transfer_length > 0.0 {
+            self.strain * (from_end / self.transfer_length).min(1.0)
+        } else {
+            self.strain
+        }
+    }
+}
+
 /// What the setup applies to the bonds between two particles of one bar.
-#[derive(Clone, Debug)]
-pub struct BarBonds<H> {
+#[derive(Clone, Debug, Default)]
+pub struct BarBonds {
     /// Bar index of each particle by global id ([`NOT_A_BAR`] for lattice particles).
     pub bar_of: Vec<u32>,
     /// Multiplier of the β of each bar's own bonds.
     pub factor: Vec<f64>,
-    /// Initial history of each bar's own bonds, for prestrained bars.
-    pub initial: Vec<Option<H>>,
+    /// Each bar, for where a bond lies along it.
+    pub bars: Vec<Bar>,
+    /// Each bar's prestrain (zero strain: none).
+    pub prestrain: Vec<Prestrain>,
 }
 
-impl<H: Attributes> BarBonds<H> {
-    /// Applies the factors and initial histories to a store whose particle `l` has global id
-    /// `gid(l)`. Run on freshly found bonds, once.
-    pub fn apply(&self, bonds: &mut BondList<H>, gid: impl Fn(usize) -> u32) {
+impl BarBonds {
+    /// Applies the factors and prestrains to a store whose particle `l` has global id `gid(l)`.
+    /// Run on freshly found bonds, once. The setup has checked that the model accepts each
+    /// bar's full prestrain; a model accepts the smaller ones of a transfer length too.
+    pub fn apply<M: Model>(
+        &self,
+        model: &M,
+        bonds: &mut BondList<M::Bond>,
+        x0: &[[f64; 3]],
+        gid: impl Fn(usize) -> u32,
+    ) {
         if self.factor.is_empty() {
             return;
         }
@@ -47,12 +75,31 @@ impl<H: Attributes> BarBonds<H> {
             if bar == NOT_A_BAR || bar != self.bar_of[gid(j) as usize] {
                 continue;
             }
-            bonds.geom[b].beta *= self.factor[bar as usize];
-            if let Some(h) = &self.initial[bar as usize] {
-                bonds.history[b] = *h;
+            let k = bar as usize;
+            bonds.geom[b].beta *= self.factor[k];
+            let prestrain = self.prestrain[k];
+            if prestrain.strain != 0.0 {
+                let (bar, mid) = (
+                    &self.bars[k],
+                    [0, 1, 2].map(|e| 0.5 * (x0[i][e] + x0[j][e])),
+                );
+                let s = along(bar, &mid);
+                let strain = prestrain.at(s.min(bar.length() - s));
+                let law = model.law(bar.material, bar.material);
+                if let Ok(h) = model.prestrained(&law, strain) {
+                    bonds.history[b] = h;
+                }
             }
         }
     }
+}
+
+/// Distance of the projection of `x` on the bar's line from the bar's start.
+fn along(bar: &Bar, x: &[f64; 3]) -> f64 {
+    let l = bar.length();
+    (0..3)
+        .map(|k| (x[k] - bar.from[k]) * (bar.to[k] - bar.from[k]) / l)
+        .sum()
 }
 
 /// γ of each bar (1 for a bar without own bonds): the factor that makes a bar of Young's
@@ -73,19 +120,13 @@ pub fn calibrate<M: Model>(
         let l = b.length();
         [0, 1, 2].map(|k| (b.to[k] - b.from[k]) / l)
     };
-    // Distance of a bar particle from its bar's start, along the bar.
-    let along = |i: usize, x0: &[f64; 3]| {
-        let b = &bars[bar(i) as usize];
-        let t = axis(b);
-        (0..3).map(|k| (x0[k] - b.from[k]) * t[k]).sum::<f64>()
-    };
     let saved = p.alter.clone();
     for i in 0..n {
         if bar(i) == NOT_A_BAR {
             continue;
         }
         let t = axis(&bars[bar(i) as usize]);
-        let s = along(i, &p.x0[i]);
+        let s = along(&bars[bar(i) as usize], &p.x0[i]);
         let a = p.alter[i].as_mut_slice();
         for k in 0..3 {
             a[k] = p.x0[i][k] + PROBE_STRAIN * s * t[k];
@@ -118,7 +159,7 @@ pub fn calibrate<M: Model>(
             continue;
         }
         let continuum = 0.5 * modulus[b as usize] * PROBE_STRAIN * PROBE_STRAIN * p.volume[i];
-        let s = along(i, &p.x0[i]);
+        let s = along(&bars[b as usize], &p.x0[i]);
         let sums = if s >= horizon && s <= bars[b as usize].length() - horizon {
             &mut interior[b as usize]
         } else {

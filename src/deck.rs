@@ -5,6 +5,7 @@
 //! checked against the dimension the key expects and converted once into the deck's unit system
 //! (see [`crate::units`]); anything semantically wrong is reported with the entry's line.
 
+use crate::bars::Prestrain;
 use crate::boundary::{History, Motion, TEMPERATURE};
 use crate::decomposition::{Procs, Walls};
 use crate::geometry::{Bar, Lattice, Op, Shape};
@@ -211,6 +212,7 @@ struct BarSection {
     spacing: Option<Length>,
     prestrain: Option<f64>,
     prestress: Option<Stress>,
+    transfer_length: Option<Length>,
 }
 
 #[derive(Deserialize)]
@@ -470,8 +472,8 @@ pub struct Scene {
     pub op_lines: Vec<usize>,
     pub bars: Vec<Bar>,
     pub bar_lines: Vec<usize>,
-    /// Initial stretch of each bar's own bonds (0: none); see `bars.rs`.
-    pub bar_prestrain: Vec<f64>,
+    /// Initial stretch of each bar's own bonds (zero strain: none); see `bars.rs`.
+    pub bar_prestrain: Vec<Prestrain>,
     pub time: TimeSpec,
     pub boundaries: Vec<BoundarySpec>,
     pub loads: Vec<LoadSpec>,
@@ -1454,21 +1456,38 @@ impl Converter {
         Ok(bar)
     }
 
-    /// A bar's initial strain, given as `prestrain` or as `prestress` over the material's E.
-    fn prestrain(&self, b: &BarSection, k: usize, line: usize, material: &Material) -> R<f64> {
+    /// A bar's initial strain, given as `prestrain` or as `prestress` over the material's E,
+    /// with its transfer length.
+    fn prestrain(
+        &self,
+        b: &BarSection,
+        k: usize,
+        line: usize,
+        material: &Material,
+    ) -> R<Prestrain> {
         let ctx = format!("bar {k}");
         let strain = match (b.prestrain, b.prestress) {
-            (None, None) => return Ok(0.0),
+            (None, None) => {
+                if b.transfer_length.is_some() {
+                    return self.err(
+                        line,
+                        format!("{ctx}: transfer_length needs prestrain or prestress"),
+                    );
+                }
+                return Ok(Prestrain::default());
+            }
             (Some(e), None) => e,
             (None, Some(stress)) => match material.youngs_modulus {
                 Some(e) => stress.value(self.sys) / e,
-                None => return self.err(
-                    line,
-                    format!(
+                None => {
+                    return self.err(
+                        line,
+                        format!(
                         "{ctx}: prestress needs youngs_modulus on material '{}'; or give prestrain",
                         material.name
                     ),
-                ),
+                    )
+                }
             },
             (Some(_), Some(_)) => {
                 return self.err(
@@ -1485,7 +1504,17 @@ impl Converter {
                 ),
             );
         }
-        Ok(strain)
+        let transfer_length = b.transfer_length.map_or(0.0, |l| l.value(self.sys));
+        if !(transfer_length.is_finite() && transfer_length >= 0.0) {
+            return self.err(
+                line,
+                format!("{ctx}: transfer_length must be a length >= 0 (got {transfer_length})"),
+            );
+        }
+        Ok(Prestrain {
+            strain,
+            transfer_length,
+        })
     }
 
     fn history(&self, h: &Option<HistorySpec>, line: usize, ctx: &str) -> R<History> {

@@ -161,7 +161,9 @@ pub fn build_cube<M: Model>(
     if let Some(g) = &setup.correction {
         crate::correction::correct_bonds(&mut bonds, &p.x0, |l| g[idx(l)]);
     }
-    setup.bars.apply(&mut bonds, |l| g.gid[idx(l)]);
+    setup
+        .bars
+        .apply(&setup.sim.model, &mut bonds, &p.x0, |l| g.gid[idx(l)]);
 
     // Global id → local index, for owned particles.
     let mut local = vec![u32::MAX; g.len()];

@@ -34,7 +34,7 @@ pub struct Setup<M: Model> {
     /// Explicit stepping, or relaxation to equilibrium at each load step.
     pub solver: crate::deck::SolverSpec,
     /// Calibration factors and prestrain of the bars' own bonds.
-    pub bars: BarBonds<M::Bond>,
+    pub bars: BarBonds,
 }
 
 /// Builds the model named by the deck and hands it to `visitor`.
@@ -153,7 +153,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     }
 
     let bars = bar_bonds(&model, &mut particles, &bonds, scene, cloud.bar)?;
-    bars.apply(&mut bonds, |i| particles.gid[i]);
+    bars.apply(&model, &mut bonds, &particles.x0, |i| particles.gid[i]);
 
     // Time step.
     let (dt_critical, dt_critical_particle) = stable_time_step(&model, &particles, &bonds);
@@ -373,13 +373,9 @@ fn bar_bonds<M: Model>(
     bonds: &BondList<M::Bond>,
     scene: &Scene,
     bar_of: Vec<u32>,
-) -> Result<BarBonds<M::Bond>, DeckError> {
+) -> Result<BarBonds, DeckError> {
     if scene.bars.is_empty() {
-        return Ok(BarBonds {
-            bar_of: Vec::new(),
-            factor: Vec::new(),
-            initial: Vec::new(),
-        });
+        return Ok(BarBonds::default());
     }
     let modulus: Vec<f64> = scene
         .bars
@@ -406,22 +402,19 @@ fn bar_bonds<M: Model>(
     } else {
         vec![1.0; scene.bars.len()]
     };
-    let mut initial = Vec::with_capacity(scene.bars.len());
-    for (k, (bar, &strain)) in scene.bars.iter().zip(&scene.bar_prestrain).enumerate() {
-        if strain == 0.0 {
-            initial.push(None);
-            continue;
+    for (k, (bar, p)) in scene.bars.iter().zip(&scene.bar_prestrain).enumerate() {
+        if p.strain != 0.0 {
+            let law = model.law(bar.material, bar.material);
+            model
+                .prestrained(&law, p.strain)
+                .map_err(|m| scene.error(Some(scene.bar_lines[k]), format!("bar {k}: {m}")))?;
         }
-        let law = model.law(bar.material, bar.material);
-        let history = model
-            .prestrained(&law, strain)
-            .map_err(|m| scene.error(Some(scene.bar_lines[k]), format!("bar {k}: {m}")))?;
-        initial.push(Some(history));
     }
     Ok(BarBonds {
         bar_of,
         factor,
-        initial,
+        bars: scene.bars.clone(),
+        prestrain: scene.bar_prestrain.clone(),
     })
 }
 

@@ -11,6 +11,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+mod girder;
 mod lap_splice;
 
 /// The resolution of a validation run.
@@ -951,6 +952,7 @@ pub fn cases(level: Level) -> Vec<Case> {
     for (suffix, velocity) in lap_splice::VELOCITIES {
         all.push(lap_splice::lap_splice(level, suffix, velocity));
     }
+    all.push(girder::prestressed_girder(level));
     all
 }
 

@@ -741,3 +741,33 @@ fn a_probe_stop_of_negative_length() {
         Some(line),
     );
 }
+
+/// A prestrained bar in a model whose bonds keep no plastic stretch (PMB): refused at the bar.
+#[test]
+fn prestrain_in_a_model_without_plastic_stretch() {
+    let bar = "[[bar]]\nmaterial = \"mortar\"\narea = \"1 mm^2\"\nfrom = \"0.2 3.2 3.2 mm\"\nto = \"5.2 3.2 3.2 mm\"\nprestrain = 0.002\n";
+    let deck = insert_before_time(bar);
+    let line = line_of(&deck, "[[bar]]");
+    assert_rejected(
+        "prestrain_pmb",
+        &deck,
+        &["bar 0", "cannot prestrain", "pmb"],
+        Some(line),
+    );
+}
+
+/// Prestrain and prestress together, and a transfer length without either.
+#[test]
+fn prestrain_given_twice_or_transfer_length_alone() {
+    let bar = "[[bar]]\nmaterial = \"mortar\"\narea = \"1 mm^2\"\nfrom = \"0.2 3.2 3.2 mm\"\nto = \"5.2 3.2 3.2 mm\"\n";
+    let deck = insert_before_time(&format!("{bar}prestrain = 0.002\nprestress = \"60 MPa\"\n"));
+    let line = line_of(&deck, "[[bar]]");
+    assert_rejected("prestrain_twice", &deck, &["bar 0", "not both"], Some(line));
+    let deck = insert_before_time(&format!("{bar}transfer_length = \"2 mm\"\n"));
+    assert_rejected(
+        "transfer_length_alone",
+        &deck,
+        &["bar 0", "transfer_length needs prestrain"],
+        Some(line),
+    );
+}
