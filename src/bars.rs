@@ -132,22 +132,9 @@ pub fn calibrate<M: Model>(
             a[k] = p.x0[i][k] + PROBE_STRAIN * s * t[k];
         }
     }
-    let mut w = vec![0.0; n];
-    for (i, j, b) in bonds.iter() {
-        if bar(i) == NOT_A_BAR || bar(i) != bar(j) {
-            continue;
-        }
-        let law = model.law(p.material[i], p.material[j]);
-        let e = model.energy(
-            &law,
-            &p.side(i),
-            &p.side(j),
-            &bonds.geom[b],
-            &bonds.history[b],
-        );
-        w[i] += 0.5 * e;
-        w[j] += 0.5 * e;
-    }
+    let w = crate::correction::particle_energies(model, p, bonds, |i, j| {
+        bar(i) != NOT_A_BAR && bar(i) == bar(j)
+    });
     p.alter.clone_from(&saved);
 
     // Per bar: (discrete, continuum) energy over its interior particles and over all of them.

@@ -30,19 +30,7 @@ pub fn energy_factors<M: Model>(
         for (a, x) in p.alter.iter_mut().zip(&p.x0) {
             a.as_mut_slice()[k] = x[k] * (1.0 + PROBE_STRAIN);
         }
-        let mut w = vec![0.0; n];
-        for (i, j, b) in bonds.iter() {
-            let law = model.law(p.material[i], p.material[j]);
-            let e = model.energy(
-                &law,
-                &p.side(i),
-                &p.side(j),
-                &bonds.geom[b],
-                &bonds.history[b],
-            );
-            w[i] += 0.5 * e;
-            w[j] += 0.5 * e;
-        }
+        let w = particle_energies(model, p, bonds, |_, _| true);
         for (i, gi) in g.iter_mut().enumerate() {
             let (lambda, mu) = model.lame(p.material[i]);
             let continuum = 0.5 * (lambda + 2.0 * mu) * PROBE_STRAIN * PROBE_STRAIN;
@@ -54,6 +42,33 @@ pub fn energy_factors<M: Model>(
         p.alter.clone_from(&saved);
     }
     g
+}
+
+/// Half the energy of each bond between particles `i` and `j` that `keep(i, j)` accepts, summed
+/// at each of its two ends.
+pub fn particle_energies<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &BondList<M::Bond>,
+    keep: impl Fn(usize, usize) -> bool,
+) -> Vec<f64> {
+    let mut w = vec![0.0; p.len()];
+    for (i, j, b) in bonds.iter() {
+        if !keep(i, j) {
+            continue;
+        }
+        let law = model.law(p.material[i], p.material[j]);
+        let e = model.energy(
+            &law,
+            &p.side(i),
+            &p.side(j),
+            &bonds.geom[b],
+            &bonds.history[b],
+        );
+        w[i] += 0.5 * e;
+        w[j] += 0.5 * e;
+    }
+    w
 }
 
 /// G_ij of a bond with reference vector `xi` between particles with factors `gi` and `gj`.

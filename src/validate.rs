@@ -561,8 +561,9 @@ struct Bars {
 /// Section of the thesis's beams: 30 in wide (y), 50 in deep (z).
 const CONCRETE_WIDTH: f64 = 30.0;
 const CONCRETE_DEPTH: f64 = 50.0;
-/// The thesis's concrete modulus, 3605 ksi (= 57,000√f'c psi), in psi.
+/// The thesis's concrete modulus, 3605 ksi (= 57,000√f'c psi), and f'c, in psi.
 const CONCRETE_E: f64 = 3.605e6;
+const FC: f64 = 4000.0;
 /// Effective depth of the reinforced beams' bars.
 const BAR_DEPTH: f64 = 46.5;
 /// The deflection at which a reinforced beam counts as collapsed, in units of the uncracked
@@ -573,6 +574,21 @@ const COLLAPSE_DEFLECTION: f64 = 10.0;
 /// (validation/README.md), so the ramp is slow, 16 first bending periods of the cantilever.
 const RC_PEAK: f64 = 2.0;
 const RC_RAMP: f64 = 0.6;
+
+/// The thesis's concrete (THEORY.md §8) as a deck's `[materials.concrete]` table.
+fn thesis_concrete() -> String {
+    format!(
+        r#"[materials.concrete]
+kind = "concrete"
+density = "145 lb/ft^3"
+youngs_modulus = "{CONCRETE_E} psi"
+poisson_ratio = 0.25
+tensile_stretch = 1.387e-4
+compressive_stretch = -1.1e-3
+compressive_strength = "{FC} psi"
+"#
+    )
+}
 
 impl ConcreteBeam {
     fn new(level: Level, length: f64, bars: Option<Bars>) -> ConcreteBeam {
@@ -586,12 +602,12 @@ impl ConcreteBeam {
 
     /// f_r = 7.5√f'c with f'c = 4000 psi.
     fn rupture_modulus() -> f64 {
-        7.5 * 4000f64.sqrt()
+        7.5 * FC.sqrt()
     }
 
     /// ACI 318-11 Eq. 11-3: V_c = 2√f'c·b·d, normalweight concrete.
     fn shear_strength() -> f64 {
-        2.0 * 4000f64.sqrt() * CONCRETE_WIDTH * BAR_DEPTH
+        2.0 * FC.sqrt() * CONCRETE_WIDTH * BAR_DEPTH
     }
 
     /// I of the section.
@@ -626,6 +642,7 @@ impl ConcreteBeam {
             ),
             Some(bars) => ("reinforced", String::new(), bars.deck(length)),
         };
+        let concrete = thesis_concrete();
         format!(
             r#"title = "validation: {kind} concrete {title} (thesis), {dx} in lattice"
 units = "in-lbf-s"
@@ -635,15 +652,7 @@ m = 3
 surface_correction = "energy"
 [lattice]
 spacing = "{dx} in"
-[materials.concrete]
-kind = "concrete"
-density = "145 lb/ft^3"
-youngs_modulus = "{CONCRETE_E} psi"
-poisson_ratio = 0.25
-tensile_stretch = 1.387e-4
-compressive_stretch = -1.1e-3
-compressive_strength = "4000 psi"
-{steel}[[geometry]]
+{concrete}{steel}[[geometry]]
 shape = "box"
 material = "concrete"
 min = "0 0 0 in"

@@ -174,7 +174,8 @@ fn the_sweep_reports_error_against_run_time() {
 
 /// Every case's deck, at both levels, is a valid deck (the long ones are not run in the test
 /// suite); the reinforced beams have their three bars and stop at their collapse, the
-/// lap splices their two bars.
+/// lap splices their two bars, the prestressed girder its eight bars and three prestressed
+/// strands.
 #[test]
 fn every_case_deck_parses() {
     for level in [Level::Quick, Level::Full] {
@@ -188,10 +189,23 @@ fn every_case_deck_parses() {
                 3
             } else if case.name.starts_with("lap_splice_") {
                 2
+            } else if case.name == "prestressed_girder" {
+                11
             } else {
                 0
             };
             assert_eq!(case.deck.matches("[[bar]]").count(), bars, "{}", case.name);
+            let strands = if case.name == "prestressed_girder" {
+                3
+            } else {
+                0
+            };
+            assert_eq!(
+                case.deck.matches("prestress =").count(),
+                strands,
+                "{}",
+                case.name
+            );
             assert_eq!(
                 case.deck.contains("stop_beyond"),
                 reinforced,

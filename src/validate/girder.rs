@@ -42,7 +42,7 @@
 //! the strands' transfer of prestress meet (validation/README.md), not the inclined crack
 //! through the web's centroid that V_cw describes.
 
-use super::{column, read_history, Case, Kind, Level, Plot};
+use super::{column, read_history, Case, Kind, Level, Plot, CONCRETE_E, FC};
 
 /// The PCI BT-72 section as (y, z) vertices in inches: y across (0 to 42), z up from the soffit.
 const SECTION: [[f64; 2]; 14] = [
@@ -63,9 +63,6 @@ const SECTION: [[f64; 2]; 14] = [
 ];
 /// The girder's length (in).
 const LENGTH: f64 = 375.0;
-/// Concrete: the thesis's (3605 ksi, ν = 0.25, f'c = 4000 psi, 145 lb/ft³); psi.
-const CONCRETE_E: f64 = 3.605e6;
-const FC: f64 = 4000.0;
 /// Mass density of the concrete, lbf·s²/in⁴ (145 lb/ft³ over g = 386.09 in/s²).
 const CONCRETE_DENSITY: f64 = 145.0 / 1728.0 / 386.09;
 const GRAVITY: f64 = 386.09;
@@ -186,7 +183,7 @@ fn web_shear_cracking(span: f64, support: f64) -> (f64, f64, f64) {
 }
 
 /// The girder at `level`: a 3 in lattice (`--quick`, about 11,700 particles) or a 2 in one
-/// (`--full`, about 38,000; the thesis's 1 in lattice, about 290,000 particles, would need a
+/// (`--full`, about 37,000; the thesis's 1 in lattice, about 290,000 particles, would need a
 /// factored tangent far beyond this machine's memory).
 pub(super) fn prestressed_girder(level: Level) -> Case {
     let dx = match level {
@@ -258,15 +255,7 @@ m = 3
 surface_correction = "energy"
 [lattice]
 spacing = "{dx} in"
-[materials.concrete]
-kind = "concrete"
-density = "145 lb/ft^3"
-youngs_modulus = "{CONCRETE_E} psi"
-poisson_ratio = 0.25
-tensile_stretch = 1.387e-4
-compressive_stretch = -1.1e-3
-compressive_strength = "{FC} psi"
-[materials.strand]
+{concrete}[materials.strand]
 kind = "steel"
 density = "490 lb/ft^3"
 youngs_modulus = "{STRAND_E} psi"
@@ -317,6 +306,7 @@ progress = false
 history_every = 1
 frames_every = 100000000
 "#,
+        concrete = super::thesis_concrete(),
         strand_yield = STRAND_YIELD / STRAND_E,
         strands = steel("strand", STRAND_AREA, &STRANDS, Some(STRAND_STRESS)),
         bars = steel("steel", BAR_AREA, &BARS, None),
