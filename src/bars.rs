@@ -56,6 +56,14 @@ pub struct BarBonds {
 }
 
 impl BarBonds {
+    /// Whether the particles with global ids `a` and `b` are two particles of one bar.
+    pub fn same_bar(&self, a: u32, b: u32) -> bool {
+        !self.bar_of.is_empty() && {
+            let bar = self.bar_of[a as usize];
+            bar != NOT_A_BAR && bar == self.bar_of[b as usize]
+        }
+    }
+
     /// Applies the factors and prestrains to a store whose particle `l` has global id `gid(l)`.
     /// Run on freshly found bonds, once. The setup has checked that the model accepts each
     /// bar's full prestrain; a model accepts the smaller ones of a transfer length too.
@@ -83,7 +91,8 @@ impl BarBonds {
                     &self.bars[k],
                     [0, 1, 2].map(|e| 0.5 * (x0[i][e] + x0[j][e])),
                 );
-                let s = along(bar, &mid);
+                // A periodic image can project outside the bar: never a negative distance.
+                let s = along(bar, &mid).clamp(0.0, bar.length());
                 let strain = prestrain.at(s.min(bar.length() - s));
                 let law = model.law(bar.material, bar.material);
                 if let Ok(h) = model.prestrained(&law, strain) {

@@ -83,14 +83,20 @@ pub fn bond_factor(xi: [f64; 3], gi: &[f64; 3], gj: &[f64; 3]) -> f64 {
     1.0 / s.sqrt()
 }
 
-/// Multiplies every bond's β by its G_ij; `g(i)` gives the factors of store particle i.
+/// Multiplies every bond's β by its G_ij; `g(i)` gives the factors of store particle i. Bonds
+/// for which `skip(i, j)` holds are left alone: a bar's own bonds, which `bars.rs` scales as a
+/// whole (the factors of a bar particle come from the body around it, not from the bar).
 pub fn correct_bonds<H: Attributes>(
     bonds: &mut BondList<H>,
     x0: &[[f64; 3]],
     g: impl Fn(usize) -> [f64; 3],
+    skip: impl Fn(usize, usize) -> bool,
 ) {
     let pairs: Vec<(usize, usize, usize)> = bonds.iter().collect();
     for (i, j, b) in pairs {
+        if skip(i, j) {
+            continue;
+        }
         let (a, c) = (x0[i], x0[j]);
         let xi = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
         bonds.geom[b].beta *= bond_factor(xi, &g(i), &g(j));

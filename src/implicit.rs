@@ -1,6 +1,7 @@
 //! Implicit static solve: Newton's method on the equilibrium equations with the tangent
-//! stiffness assembled as a sparse matrix and factored by `faer` (sparse Cholesky, LU if the
-//! matrix is not positive definite). For elastic states it reaches equilibrium in a few force
+//! stiffness assembled as a sparse matrix and factored by `faer` (sparse Cholesky; once bonds
+//! have broken, Cholesky with a slightly raised diagonal; LU if neither works), after a check
+//! that the factor fits in memory. For elastic states it reaches equilibrium in a few force
 //! evaluations per load step where relaxation needs thousands.
 //!
 //! The tangent is assembled from the engine's own force evaluation, for every model alike
@@ -12,8 +13,8 @@
 //! own `drift`, so finite-rotation coordinates (quaternions) are handled as the integrator
 //! handles them.
 //!
-//! The tangent is kept while the bonds stay as they are and rebuilt when bonds break (modified
-//! Newton). Loads are dead loads; supported DOFs are eliminated (their motion is imposed
+//! The tangent is kept while the Newton iterations at least halve the residual and rebuilt
+//! when they do not (modified Newton): a few broken bonds leave it usable. Loads are dead loads; supported DOFs are eliminated (their motion is imposed
 //! before the iterations, as in relaxation). One procCube only: the matrix is assembled and
 //! factored in one process.
 
@@ -196,6 +197,48 @@ fn bond_blocks<M: Model>(
     triplets
 }
 
+/// The factor may take at most this fraction of the memory the system reports available. The
+/// estimate below is already generous (twice the factor's values: the full micropolar beam's
+/// estimate was 26.5 GiB; the kernel killed it at 24 GiB), so all of it.
+const FACTOR_MEMORY_SHARE: f64 = 1.0;
+
+/// Refuses, with the sizes, a tangent whose Cholesky factor would not fit in memory: the
+/// symbolic factorization (ordering and column counts, cheap) gives the factor's nonzeros
+/// before any memory is spent on it. Without this check an oversized factor is not an error
+/// but the kernel's out-of-memory kill, after an hour and with the run's results lost.
+fn check_factor_memory(lower: &SparseColMat<usize, f64>, free: usize) -> Result<(), String> {
+    let Some(available) = available_memory() else {
+        return Ok(());
+    };
+    let symbolic = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
+        lower.symbolic(),
+        faer::Side::Lower,
+        Default::default(),
+        Default::default(),
+    )
+    .map_err(|e| format!("ordering the tangent stiffness: {e:?}"))?;
+    // Values, and about as much again for row indices and the numeric phase's workspace.
+    let needed = 2.0 * symbolic.len_val() as f64 * std::mem::size_of::<f64>() as f64;
+    if needed > FACTOR_MEMORY_SHARE * available {
+        let gib = |b: f64| b / (1u64 << 30) as f64;
+        return Err(format!(
+            "the implicit solve's factored tangent would need about {:.1} GiB ({} nonzeros over {free} free DOFs), more than the {:.1} GiB of memory available: use [solver] kind = \"adr\" (memory in proportion to the particles), or a coarser lattice",
+            gib(needed),
+            symbolic.len_val(),
+            gib(FACTOR_MEMORY_SHARE * available)
+        ));
+    }
+    Ok(())
+}
+
+/// Bytes of memory available to new allocations (Linux `MemAvailable`), if known.
+fn available_memory() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
+}
+
 /// Relative shift of the diagonal that makes a nearly positive definite tangent factorable.
 const DIAGONAL_SHIFT: f64 = 1e-6;
 
@@ -225,12 +268,13 @@ fn shifted_cholesky(
         .ok()
 }
 
-/// Factors the lower triangle given as triplets: Cholesky, else Cholesky with a slightly
-/// raised diagonal, else LU of the whole matrix.
+/// Factors the lower triangle given as triplets: Cholesky, else (with `broken` bonds) Cholesky
+/// with a slightly raised diagonal, else LU of the whole matrix.
 fn factor(
     triplets: Vec<Triplet<usize, usize, f64>>,
     index: Vec<usize>,
     free: usize,
+    broken: usize,
     evaluations: u64,
     colours: usize,
     start: Instant,
@@ -238,9 +282,12 @@ fn factor(
     let nonzeros = triplets.len();
     let lower = SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &triplets)
         .map_err(|e| format!("assembling the tangent stiffness: {e:?}"))?;
+    check_factor_memory(&lower, free)?;
     let (factor, method) = match lower.sp_cholesky(faer::Side::Lower) {
         Ok(f) => (Factor::Cholesky(f), "Cholesky"),
-        Err(_) => match shifted_cholesky(&triplets, free) {
+        // Only once bonds have broken: an intact scene that is not positive definite has a
+        // mechanism (supports leaving a rigid-body motion free), which a shift would hide.
+        Err(_) => match shifted_cholesky(&triplets, free).filter(|_| broken > 0) {
             Some(f) => (Factor::Cholesky(f), "Cholesky, shifted"),
             None => {
                 // Not positive definite (a model without a potential, or a mechanism): LU of
@@ -320,7 +367,8 @@ impl<M: Model> Cube<M> {
                 &index,
                 PERTURBATION * shortest,
             );
-            return factor(triplets, index, free, 4 * n2 as u64, 0, start);
+            let broken = sim.bonds.broken_count();
+            return factor(triplets, index, free, broken, 4 * n2 as u64, 0, start);
         }
         // A state sums over a family: forces reach two bond lengths.
         let reach = 2.0 * longest;
@@ -354,6 +402,7 @@ impl<M: Model> Cube<M> {
 
         let saved_alter = self.sim.particles.alter.clone();
         let saved_broken = self.sim.bonds.broken.clone();
+        let broken = saved_broken.iter().filter(|&&b| b).count();
         let saved_history = self.sim.bonds.history.clone();
         let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
         let mut plus = vec![0.0; n * n2];
@@ -416,7 +465,15 @@ impl<M: Model> Cube<M> {
         self.sim.bonds.broken = saved_broken;
         self.sim.bonds.history = saved_history;
         self.sim.compute_forces();
-        factor(triplets, index, free, evaluations, colours.len(), start)
+        factor(
+            triplets,
+            index,
+            free,
+            broken,
+            evaluations,
+            colours.len(),
+            start,
+        )
     }
 
     /// One load step of the implicit solve: supports and loads move to `sim.time + sim.dt`,

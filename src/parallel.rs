@@ -159,7 +159,13 @@ pub fn build_cube<M: Model>(
     let mut bonds: BondList<M::Bond> =
         plan.find_bonds(&p.x0, setup.horizon, setup.spacing, setup.partial_volume);
     if let Some(g) = &setup.correction {
-        crate::correction::correct_bonds(&mut bonds, &p.x0, |l| g[idx(l)]);
+        let gid = |l: usize| setup.sim.particles.gid[idx(l)];
+        crate::correction::correct_bonds(
+            &mut bonds,
+            &p.x0,
+            |l| g[idx(l)],
+            |a, b| setup.bars.same_bar(gid(a), gid(b)),
+        );
     }
     setup
         .bars

@@ -132,7 +132,13 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
             ));
         }
         let g = crate::correction::energy_factors(&model, &mut particles, &bonds);
-        crate::correction::correct_bonds(&mut bonds, &particles.x0, |i| g[i]);
+        let bar = |i: usize| cloud.bar[particles.gid[i] as usize];
+        crate::correction::correct_bonds(
+            &mut bonds,
+            &particles.x0,
+            |i| g[i],
+            |i, j| bar(i) != geometry::NOT_A_BAR && bar(i) == bar(j),
+        );
         Some(g)
     } else {
         None

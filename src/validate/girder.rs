@@ -11,9 +11,10 @@
 //! - flexural: the bottom fibre reaches f_r = 7.5√f'c under P_i/A + P_i·e·y_b/I and the
 //!   midspan moment of the self-weight and the load, M = w·L²/8 + P·(2L − a)/8 (a the loading
 //!   plate's length);
-//! - web-shear (Eq. 11-12): V_cw = (3.5√f'c + 0.3 f_pc)·b_w·d_p at h/2 from the support, with
-//!   f_pc = P/A at the centroid reduced linearly within the transfer length (§11.3.4) and
-//!   d_p ≥ 0.8h; the load is then 2·(V_cw − w·(L/2 − h/2)).
+//! - web-shear (Eq. 11-12): V_cw = (3.5√f'c + 0.3 f_pc)·b_w·d_p at h/2 from the face of the
+//!   support (the bearing plate's inner edge), with f_pc = P/A at the centroid reduced linearly
+//!   within the transfer length (§11.3.4, here the model's 60 d_b, where ACI assumes 50 d_b)
+//!   and d_p ≥ 0.8h; the load is then the midspan load whose shear there is V_cw.
 //!
 //! Assumed and said in the report (the thesis's Figures 4.23–4.25 are not in its text): the
 //! section is the PCI BT-72 drawn as one polygon (42 in top flange 3.5 in thick with a 2 in
@@ -170,15 +171,18 @@ fn flexural_cracking_load(span: f64, a: f64) -> f64 {
     8.0 * (cracking_moment - self_weight() * span * span / 8.0) / (2.0 * span - a)
 }
 
-/// ACI 318-11 Eq. 11-12 at h/2 from the support line at `support` from the girder's end, for
-/// supports `span` apart: (V_cw, f_pc, the midspan load whose end shear there is V_cw).
+/// ACI 318-11 Eq. 11-12 at h/2 from the face of the support (the bearing plate's inner edge),
+/// for support lines at `support` from the girder's ends and `span` apart: (V_cw, f_pc, the
+/// midspan load whose shear there is V_cw).
 fn web_shear_cracking(span: f64, support: f64) -> (f64, f64, f64) {
     let (area, _, _) = transformed_section();
-    let section = support + HEIGHT / 2.0;
+    // h/2 from the face of the support, the bearing plate's inner edge; the strands start at
+    // the girder's end.
+    let section = BEARING[0] + HEIGHT / 2.0;
     let f_pc = prestress_force() / area * (section / transfer_length()).min(1.0);
     let d_p = (HEIGHT - STRANDS[0][1]).max(0.8 * HEIGHT);
     let v_cw = (3.5 * FC.sqrt() + 0.3 * f_pc) * WEB * d_p;
-    let load = 2.0 * (v_cw - self_weight() * (span / 2.0 - HEIGHT / 2.0));
+    let load = 2.0 * (v_cw - self_weight() * (span / 2.0 - (section - support)));
     (v_cw, f_pc, load)
 }
 
@@ -331,7 +335,7 @@ frames_every = 100000000
         reference,
         thesis: None,
         formula: format!(
-            "the smaller of ACI 318-11's cracking loads on the transformed section (A = {area:.0} in², y_b = {yb:.2} in, I = {inertia:.0} in⁴; the gross PCI BT-72 has 767 in², 36.60 in, 545,894 in⁴), prestress P_i = 3 × {STRAND_AREA} in² × {:.1} ksi = {:.0} lbf (270 ksi strand at 0.75 f_pu) at e = {:.2} in, self-weight w = {:.1} lbf/in, supports L = {span} in apart: web-shear, Eq. 11-12 V_cw = (3.5√f'c + 0.3 f_pc)·b_w·d_p = {v_cw:.0} lbf at h/2 from the support (f_pc = {f_pc:.0} psi, reduced within the transfer length of {:.1} in; b_w = {WEB} in, d_p = {:.1} in), load {web_shear:.0} lbf; flexural, the bottom fibre at f_r = 7.5√f'c = {:.1} psi under M = wL²/8 + P(2L − a)/8 (a = {} in, the loading plate), load {flexural:.0} lbf; strand and bar placement assumed (the thesis's figures are not in its text); the thesis shows pictures only",
+            "the smaller of ACI 318-11's cracking loads on the transformed section (A = {area:.0} in², y_b = {yb:.2} in, I = {inertia:.0} in⁴; the gross PCI BT-72 has 767 in², 36.60 in, 545,894 in⁴), prestress P_i = 3 × {STRAND_AREA} in² × {:.1} ksi = {:.0} lbf (270 ksi strand at 0.75 f_pu) at e = {:.2} in, self-weight w = {:.1} lbf/in, supports L = {span} in apart: web-shear, Eq. 11-12 V_cw = (3.5√f'c + 0.3 f_pc)·b_w·d_p = {v_cw:.0} lbf at h/2 from the face of the support (the bearing plate's inner edge; f_pc = {f_pc:.0} psi, P_i/A with the elastic shortening loss only, reduced within the transfer length of {:.1} in, AASHTO's 60 d_b as in the model, where ACI's §11.3.4 assumes 50 d_b; b_w = {WEB} in, d_p = {:.1} in), load {web_shear:.0} lbf; flexural, the bottom fibre at f_r = 7.5√f'c = {:.1} psi under M = wL²/8 + P(2L − a)/8 (a = {} in, the loading plate), load {flexural:.0} lbf; strand and bar placement assumed (the thesis's figures are not in its text); the thesis shows pictures only",
             STRAND_STRESS / 1e3,
             prestress_force(),
             yb - STRANDS[0][1],
@@ -392,14 +396,14 @@ mod tests {
     fn web_shear_governs_the_cracking_of_this_girder() {
         let (support, span) = (4.5, LENGTH - 9.0);
         let (v_cw, f_pc, load) = web_shear_cracking(span, support);
-        // At h/2 = 36 in from the support the prestress has grown to 40.5/56.5 of its full
-        // value; P_i/A_tr is 519 psi.
+        // At h/2 = 36 in from the bearing plate's inner edge (9 in from the end) the prestress
+        // has grown to 45/56.5 of its full value; the section is 40.5 in from the support line.
         let (a, _, _) = transformed_section();
         let full = prestress_force() / a;
-        assert!((f_pc / full - 40.5 / transfer_length()).abs() < 1e-12);
+        assert!((f_pc / full - 45.0 / transfer_length()).abs() < 1e-12);
         let expected = (3.5 * 4000f64.sqrt() + 0.3 * f_pc) * 6.0 * 69.0;
         assert!((v_cw - expected).abs() < 1e-9 * expected);
-        assert!((load - 2.0 * (v_cw - self_weight() * (span / 2.0 - 36.0))).abs() < 1e-6);
+        assert!((load - 2.0 * (v_cw - self_weight() * (span / 2.0 - 40.5))).abs() < 1e-6);
         assert!(load < flexural_cracking_load(span, 36.0));
     }
 }
