@@ -207,6 +207,25 @@ impl Model for Lps {
         }
     }
 
+    fn relaxation_stiffness(
+        &self,
+        law: &Law,
+        i: &Side<Self>,
+        j: &Side<Self>,
+        geom: &BondGeom,
+    ) -> Force3 {
+        // The force's derivative along the bond, ω (bᵢ/mᵢ + bⱼ/mⱼ), plus the dilatation's
+        // coupling to the other bonds of each end, 3|aᵢ|ω/mᵢ per bond (Cauchy–Schwarz:
+        // (Σ ω L V)² ≤ Σ ω V · mᵢ). Near a free face mᵢ is small and the bonds stiffer, which
+        // the continuum micromodulus of `bond_stiffness` does not see.
+        let w = self.omega(geom.length);
+        let end = |a: f64, b: f64, m: f64| (b + 3.0 * a.abs()) / m;
+        let c = w
+            * (end(law.ai, law.bi, i.fixed.weighted_volume)
+                + end(law.aj, law.bj, j.fixed.weighted_volume));
+        Force3 { force: [c; 3] }
+    }
+
     fn lame(&self, material: u16) -> (f64, f64) {
         let (k, g) = self.moduli[material as usize];
         (k - 2.0 * g / 3.0, g)

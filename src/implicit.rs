@@ -568,6 +568,7 @@ impl<M: Model> Cube<M> {
             iterations: evaluations,
             residual,
             converged: residual <= tolerance,
+            diverged: false,
         })
     }
 }

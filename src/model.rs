@@ -317,6 +317,21 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     /// per unit volume of both ends.
     fn bond_stiffness(&self, law: &Self::Law, geom: &BondGeom) -> Self::Force;
 
+    /// The shape of adaptive dynamic relaxation's fictitious mass (`src/relaxation.rs`): a
+    /// bond's share of its ends' tangent stiffness, per DOF, in the units of
+    /// [`Model::bond_stiffness`], which it defaults to. Only its distribution over the
+    /// particles matters (the scale is measured); a state-based model whose stiffness depends
+    /// on its ends' fixed values (LPS: their weighted volumes) says so here.
+    fn relaxation_stiffness(
+        &self,
+        law: &Self::Law,
+        _i: &Side<Self>,
+        _j: &Side<Self>,
+        geom: &BondGeom,
+    ) -> Self::Force {
+        self.bond_stiffness(law, geom)
+    }
+
     /// The history of a bond held at an initial stretch `strain` under law `law` (a prestrained
     /// bar's own bonds, `[[bar]] prestrain`): the bond is unstressed at length (1 − strain)·|ξ|,
     /// so at its reference length it pulls its ends together with the force of that stretch.

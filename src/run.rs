@@ -121,7 +121,7 @@ fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
 enum QuasiStatic {
     /// Adaptive dynamic relaxation with these fictitious masses by global id.
     Adr {
-        mass: Vec<f64>,
+        mass: crate::relaxation::FictitiousMass,
         tolerance: f64,
         max_iterations: u64,
     },
@@ -455,7 +455,14 @@ fn drive<M: Model>(
     let mut checkpoints: Vec<(PathBuf, u64, f64)> = Vec::new();
     let mut last_checkpoint = Instant::now();
     let mut interrupted = None;
-    let (mut evaluations, mut converged) = (0u64, 0u64);
+    // The fictitious mass's estimate counts: it is force evaluations the solve needed.
+    let estimate = match &plan.relaxation {
+        Some(QuasiStatic::Adr { mass, .. }) => mass.evaluations,
+        _ => 0,
+    };
+    let (mut evaluations, mut converged) = (estimate, 0u64);
+    // Grows (doubles) only if relaxation diverges with the estimated masses.
+    let mut mass_scale = 1.0f64;
     let mut relaxed: Option<crate::relaxation::Relaxed> = None;
     let mut tangent: Option<crate::implicit::Tangent> = None;
     let workers = cube.sim.exchange.transport().size();
@@ -477,7 +484,18 @@ fn drive<M: Model>(
                     mass,
                     tolerance,
                     max_iterations,
-                }) => Some(cube.relax_step(mass, *tolerance, *max_iterations)),
+                }) => {
+                    let before = mass_scale;
+                    let r =
+                        cube.relax_step(&mass.by_gid, &mut mass_scale, *tolerance, *max_iterations);
+                    if mass_scale != before && root {
+                        eprintln!(
+                            "warning    relaxation diverged at step {step}: repeated with the fictitious masses ×{mass_scale}{}",
+                            if r.diverged { ", and diverged again" } else { "" }
+                        );
+                    }
+                    Some(r)
+                }
                 Some(QuasiStatic::Implicit {
                     tolerance,
                     max_iterations,
@@ -859,9 +877,16 @@ fn run_setup<M: Model>(
                     max_iterations,
                 })
             } else {
-                let sim = &setup.sim;
-                let mass =
-                    crate::relaxation::fictitious_mass(&sim.model, &sim.particles, &sim.bonds);
+                let mass = crate::relaxation::fictitious_mass(&mut setup.sim);
+                if !opts.quiet {
+                    match mass.lambda_max {
+                        Some(l) => eprintln!(
+                            "relaxation fictitious mass from the stiffest mode, λ_max = {l:.4} of the Gershgorin bound's 2 ({} force evaluations)",
+                            mass.evaluations
+                        ),
+                        None => eprintln!("relaxation fictitious mass: the book's (rotational DOFs, or no free DOF with a bond)"),
+                    }
+                }
                 Some(QuasiStatic::Adr {
                     mass,
                     tolerance,

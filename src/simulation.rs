@@ -207,10 +207,22 @@ pub fn stiffness_sums<M: Model>(
     p: &Particles<M>,
     bonds: &BondList<M::Bond>,
 ) -> Vec<M::Force> {
+    stiffness_sums_of(model, p, bonds, |law, _, _, geom| {
+        model.bond_stiffness(law, geom)
+    })
+}
+
+/// Σ_j V_j C_ij with C_ij from `stiffness(law, i, j, geom)`.
+pub fn stiffness_sums_of<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &BondList<M::Bond>,
+    stiffness: impl Fn(&M::Law, usize, usize, &crate::model::BondGeom) -> M::Force,
+) -> Vec<M::Force> {
     let mut sum = vec![M::Force::default(); p.len()];
     for (i, j, b) in bonds.iter() {
         let law = model.law(p.material[i], p.material[j]);
-        let c = model.bond_stiffness(&law, &bonds.geom[b]);
+        let c = stiffness(&law, i, j, &bonds.geom[b]);
         let c = c.as_slice();
         // β ≤ 1 (partial volume) is left out, which errs on the safe side; a calibrated bar bond
         // (bars.rs) or a surface-corrected one can be stiffer than its law, and counts.
