@@ -222,6 +222,7 @@ struct TimeSection {
     duration: Option<Time>,
     dt: Option<Time>,
     safety_factor: Option<f64>,
+    critical_step: Option<String>,
     force_dt: Option<bool>,
     integrator: Option<String>,
     stop_at_broken_bonds: Option<i64>,
@@ -331,11 +332,23 @@ pub struct ParallelSpec {
     pub skin: f64,
 }
 
+/// How the critical time step of an explicit run is found (`[time] critical_step`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CriticalStep {
+    /// The Silling–Askari bound, per particle from its bonds (THEORY.md §4).
+    Bound,
+    /// 2/√λ_max(M⁻¹K), the limit of central differences, with λ_max measured by a Lanczos run
+    /// at setup (`spectrum::critical_time_step`).
+    Measured,
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct TimeSpec {
     pub length: RunLength,
     pub dt: Option<f64>,
     pub safety_factor: f64,
+    /// What Δt_crit is: the Silling–Askari bound, or measured from the stiffest mode.
+    pub critical_step: CriticalStep,
     pub force_dt: bool,
     pub integrator: Integrator,
     /// End the run after the first step (load step) at which at least this many bonds have
@@ -786,6 +799,17 @@ impl Converter {
         if dt.is_some() && t.safety_factor.is_some() {
             return self.err(time_line, "[time] give 'dt' or 'safety_factor', not both");
         }
+        let critical_step =
+            match t.critical_step.as_deref().unwrap_or("bound") {
+                "bound" => CriticalStep::Bound,
+                "measured" => CriticalStep::Measured,
+                other => return self.err(
+                    time_line,
+                    format!(
+                        "[time] critical_step must be \"bound\" or \"measured\" (got \"{other}\")"
+                    ),
+                ),
+            };
         let stop_at_broken_bonds = match t.stop_at_broken_bonds {
             None => 0,
             Some(n) if n >= 1 => n as u64,
@@ -1042,6 +1066,7 @@ impl Converter {
                 length,
                 dt,
                 safety_factor,
+                critical_step,
                 force_dt: t.force_dt.unwrap_or(false),
                 integrator,
                 stop_at_broken_bonds,

@@ -334,21 +334,17 @@ impl<M: Model> Cube<M> {
             return Err("the implicit solve runs on one procCube (--threads 1, no mpirun): the tangent is assembled and factored in one process".into());
         }
         // Supported DOFs.
-        let mut index = vec![0usize; n * n2];
-        for c in &self.sim.constraints {
-            for &i in &c.particles {
-                for &k in c.dofs.iter().filter(|&&k| k < n2) {
-                    index[i as usize * n2 + k] = usize::MAX;
-                }
-            }
-        }
         let mut free = 0;
-        for v in index.iter_mut() {
-            if *v != usize::MAX {
-                *v = free;
-                free += 1;
-            }
-        }
+        let index: Vec<usize> = (self.sim.free_dofs().iter())
+            .map(|&f| {
+                if f {
+                    free += 1;
+                    free - 1
+                } else {
+                    usize::MAX
+                }
+            })
+            .collect();
         // Reach of a particle's force: the longest bond, twice over a state pass.
         let sim = &self.sim;
         let (mut longest, mut shortest) = (0.0f64, f64::INFINITY);

@@ -35,6 +35,7 @@ pub mod setup;
 pub mod shuffle;
 pub mod signals;
 pub mod simulation;
+pub mod spectrum;
 pub mod stress;
 pub mod timing;
 pub mod units;

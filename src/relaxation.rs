@@ -22,7 +22,7 @@
 //! stability needs, which costs about √6.6 in iterations. PDQ keeps the Gershgorin shape,
 //! b_i = V_i Σ_j V_j C_ij per DOF with C_ij from [`Model::relaxation_stiffness`] (a diagonal
 //! preconditioner), and scales it by a measured λ_max(B⁻¹K): a Lanczos run of
-//! [`LANCZOS_STEPS`] force evaluations on the undeformed scene, with K applied as force
+//! [`crate::spectrum::LANCZOS_STEPS`] force evaluations on the undeformed scene, with K applied as force
 //! differences. The masses are then b_i · λ_max / [`TARGET_EIGENVALUE`], 7/8 of the stability
 //! limit; stiffness only falls as bonds break, and should the iterations diverge all the same,
 //! `relax_step` repeats the load step with doubled masses. The estimate is made once,
@@ -42,20 +42,11 @@ use std::time::Instant;
 /// stiffest mode cannot be estimated (no free DOF with a bond).
 const MASS_SAFETY: f64 = 5.0;
 
-/// Krylov steps of the estimate of λ_max(B⁻¹K): the top Ritz value of 30 steps is within a
-/// few per cent of λ_max on the suite's scenes (it changes by less than 1 % from 30 to 60 steps).
-pub const LANCZOS_STEPS: usize = 30;
-
 /// The largest eigenvalue of M⁻¹K the masses are scaled to: 7/8 of the stability limit 4 of
 /// the pseudo time step 1. The estimate is converged (the same four digits at 30, 60 and 120
 /// steps on the suite's cantilevers) and stiffness only falls as bonds break, so the margin is
 /// for what the estimate cannot see; `relax_step` doubles the masses if the iterations diverge.
 pub const TARGET_EIGENVALUE: f64 = 3.5;
-
-/// A perturbation's largest displacement, relative to the shortest bond: small enough that no
-/// bond breaks and the force difference is linear, large enough against rounding (10⁻¹⁰ of the
-/// coordinates' size at most).
-const PROBE_DISPLACEMENT: f64 = 1e-6;
 
 /// Damping used when the stiffness estimate asks for more than critical (both reference codes).
 const DAMPING_CAP: f64 = 1.9;
@@ -103,13 +94,9 @@ pub fn fictitious_mass<M: Model>(sim: &mut Simulation<M>) -> FictitiousMass {
             shape[i * n2 + k] = p.volume[i] * sum.as_slice()[k];
         }
     }
-    let mut free: Vec<bool> = shape.iter().map(|&b| b > 0.0).collect();
-    for c in &sim.constraints {
-        for &i in &c.particles {
-            for &k in c.dofs.iter().filter(|&&k| k < n2) {
-                free[i as usize * n2 + k] = false;
-            }
-        }
+    let mut free = sim.free_dofs();
+    for (f, &b) in free.iter_mut().zip(&shape) {
+        *f &= b > 0.0;
     }
     // Rotational DOFs keep the book's masses: with the measured masses the quick micropolar
     // simply supported beam stalled at a relative residual of 3–20 over 20,000 iterations
@@ -117,7 +104,7 @@ pub fn fictitious_mass<M: Model>(sim: &mut Simulation<M>) -> FictitiousMass {
     if n2 > 3 {
         free.iter_mut().for_each(|f| *f = false);
     }
-    let (lambda_max, evaluations) = match stiffest_mode(sim, &shape, &free) {
+    let (lambda_max, evaluations) = match crate::spectrum::stiffest_mode(sim, &shape, &free) {
         Some((l, e)) if l.is_finite() && l > 0.0 => (Some(l), e),
         Some((_, e)) => (None, e),
         None => (None, 0),
@@ -138,148 +125,6 @@ pub fn fictitious_mass<M: Model>(sim: &mut Simulation<M>) -> FictitiousMass {
         lambda_max,
         evaluations,
     }
-}
-
-/// λ_max of B⁻¹K over the free DOFs by Lanczos on B^-½ K B^-½, with K·y from the force change
-/// under a small displacement along y; and the force evaluations it took. Restores the scene.
-fn stiffest_mode<M: Model>(
-    sim: &mut Simulation<M>,
-    shape: &[f64],
-    free: &[bool],
-) -> Option<(f64, u64)> {
-    let n2 = second_order::<M>();
-    let dofs: Vec<usize> = (0..free.len()).filter(|&d| free[d]).collect();
-    let shortest = sim
-        .bonds
-        .geom
-        .iter()
-        .map(|g| g.length)
-        .fold(f64::INFINITY, f64::min);
-    if dofs.is_empty() || !shortest.is_finite() {
-        return None;
-    }
-    let scale: Vec<f64> = dofs.iter().map(|&d| 1.0 / shape[d].sqrt()).collect();
-    let saved = (
-        sim.particles.alter.clone(),
-        sim.particles.state.clone(),
-        sim.particles.force.clone(),
-        sim.bonds.history.clone(),
-        sim.bonds.broken.clone(),
-        sim.constraints
-            .iter()
-            .map(|c| c.reaction.clone())
-            .collect::<Vec<_>>(),
-    );
-    let forces = |sim: &Simulation<M>| -> Vec<f64> {
-        dofs.iter()
-            .map(|&d| sim.particles.force[d / n2].as_slice()[d % n2])
-            .collect()
-    };
-    sim.compute_forces();
-    let f0 = forces(sim);
-    let mut evaluations = 1u64;
-    // q ↦ B^-½ K B^-½ q.
-    let mut apply = |sim: &mut Simulation<M>, q: &[f64]| -> Vec<f64> {
-        let y: Vec<f64> = q.iter().zip(&scale).map(|(q, s)| q * s).collect();
-        // Sized on the translations, so that rotations move by a like amount times 1/length.
-        let largest = |translations: bool| {
-            dofs.iter()
-                .zip(&y)
-                .filter(|(&d, _)| !translations || d % n2 < 3)
-                .fold(0.0f64, |m, (_, y)| m.max(y.abs()))
-        };
-        let mut top = largest(true);
-        if top == 0.0 {
-            top = largest(false);
-        }
-        let h = PROBE_DISPLACEMENT * shortest / top.max(f64::MIN_POSITIVE);
-        for (&d, y) in dofs.iter().zip(&y) {
-            sim.particles.alter[d / n2].as_mut_slice()[d % n2] =
-                saved.0[d / n2].as_slice()[d % n2] + h * y;
-        }
-        sim.compute_forces();
-        evaluations += 1;
-        forces(sim)
-            .iter()
-            .zip(&f0)
-            .zip(&scale)
-            .map(|((f, f0), s)| -(f - f0) / h * s)
-            .collect()
-    };
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
-    // A start with every mode in it, the same on every layout (a function of global ids).
-    let mut q: Vec<f64> = dofs
-        .iter()
-        .map(|&d| {
-            let key = (sim.particles.gid[d / n2] as u64) * n2 as u64 + (d % n2) as u64;
-            (crate::geometry::splitmix64(key) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        })
-        .collect();
-    let norm = dot(&q, &q).sqrt();
-    q.iter_mut().for_each(|v| *v /= norm);
-    let mut previous = vec![0.0; q.len()];
-    let (mut alpha, mut beta) = (Vec::new(), Vec::new());
-    for _ in 0..LANCZOS_STEPS {
-        let mut w = apply(sim, &q);
-        let a = dot(&q, &w);
-        let b_prev = beta.last().copied().unwrap_or(0.0);
-        for ((w, q), p) in w.iter_mut().zip(&q).zip(&previous) {
-            *w -= a * q + b_prev * p;
-        }
-        alpha.push(a);
-        let b = dot(&w, &w).sqrt();
-        if b.is_nan() || b <= 1e-12 * a.abs() {
-            break;
-        }
-        beta.push(b);
-        previous = std::mem::replace(&mut q, w.iter().map(|w| w / b).collect());
-    }
-    beta.truncate(alpha.len() - 1);
-    let p = &mut sim.particles;
-    (p.alter, p.state, p.force) = (saved.0, saved.1, saved.2);
-    (sim.bonds.history, sim.bonds.broken) = (saved.3, saved.4);
-    for (c, r) in sim.constraints.iter_mut().zip(saved.5) {
-        c.reaction = r;
-    }
-    Some((largest_eigenvalue(&alpha, &beta), evaluations))
-}
-
-/// The largest eigenvalue of the symmetric tridiagonal matrix with diagonal `a` and
-/// off-diagonal `b`, by bisection on the Sturm count.
-fn largest_eigenvalue(a: &[f64], b: &[f64]) -> f64 {
-    let below = |x: f64| {
-        let mut count = 0;
-        let mut d = 1.0;
-        for (i, &ai) in a.iter().enumerate() {
-            let off = if i > 0 { b[i - 1] * b[i - 1] } else { 0.0 };
-            d = ai - x - if i > 0 { off / d } else { 0.0 };
-            if d == 0.0 {
-                d = -f64::EPSILON * (ai.abs() + x.abs()).max(f64::MIN_POSITIVE);
-            }
-            count += (d < 0.0) as usize;
-        }
-        count
-    };
-    let radius =
-        |i: usize| (if i > 0 { b[i - 1].abs() } else { 0.0 }) + b.get(i).map_or(0.0, |v| v.abs());
-    let mut lo = (0..a.len())
-        .map(|i| a[i] - radius(i))
-        .fold(f64::INFINITY, f64::min);
-    let mut hi = (0..a.len())
-        .map(|i| a[i] + radius(i))
-        .fold(f64::NEG_INFINITY, f64::max);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        if below(mid) == a.len() {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    hi
 }
 
 /// Second-order coordinates minus their reference (translations from x0, rotations from 0).
@@ -500,19 +345,4 @@ pub fn check_model<M: Model>(implicit: bool) -> Result<(), String> {
         return Err("[solver] the model has no degrees of freedom".into());
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::largest_eigenvalue;
-
-    #[test]
-    fn tridiagonal_top_eigenvalue() {
-        // The path graph's Laplacian 2, −1: eigenvalues 2 − 2cos(kπ/(n+1)).
-        let n = 12;
-        let top = largest_eigenvalue(&vec![2.0; n], &vec![-1.0; n - 1]);
-        let exact = 2.0 - 2.0 * (n as f64 * std::f64::consts::PI / (n as f64 + 1.0)).cos();
-        assert!((top - exact).abs() < 1e-12, "{top} against {exact}");
-        assert_eq!(largest_eigenvalue(&[3.5], &[]), 3.5);
-    }
 }

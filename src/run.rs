@@ -271,12 +271,12 @@ fn blow_up<M: Model>(
         "relaxation diverged: check the loads, supports and materials".to_string()
     } else if ratio > 1.0 {
         format!(
-            "the time step is {ratio:.2} × the stable bound ({:.4e} against {:.4e}): lower dt or drop force_dt",
+            "the time step is {ratio:.2} × the critical step ({:.4e} against {:.4e}): lower dt or drop force_dt",
             cube.sim.dt, plan.dt_critical
         )
     } else {
         format!(
-            "the time step is within the stable bound ({ratio:.2} × {:.4e}): check the material's stiffness and density, and the loads and prescribed velocities",
+            "the time step is within the critical step ({ratio:.2} × {:.4e}): check the material's stiffness and density, and the loads and prescribed velocities",
             plan.dt_critical
         )
     };
@@ -940,7 +940,7 @@ fn run_setup<M: Model>(
         layout: layout.describe(),
         first_step: resume.map_or(0, |c| c.step),
         relaxation: relaxation.clone(),
-        dt_critical: setup.dt_critical,
+        dt_critical: setup.dt_limit(),
         material_names: scene.materials.iter().map(|m| m.name.clone()).collect(),
         spacing: scene.spacing,
         checkpoints: CheckpointPlan {
@@ -1164,13 +1164,23 @@ fn describe<M: Model>(setup: &Setup<M>, scene: &Scene) -> String {
         "memory     {:.1} MiB (particles and bonds)",
         mem as f64 / 1048576.0
     );
+    let critical = match setup.dt_measured {
+        Some((dt, evaluations)) => format!(
+            "{dt:.4e} measured on the stiffest mode ({evaluations} force evaluations; the Silling–Askari bound is {:.4e}, {:.2} x below, set by particle {})",
+            setup.dt_critical,
+            dt / setup.dt_critical,
+            p.gid[setup.dt_critical_particle]
+        ),
+        None => format!(
+            "{:.4e} (Silling–Askari bound, particle {})",
+            setup.dt_critical, p.gid[setup.dt_critical_particle]
+        ),
+    };
     let _ = writeln!(
         s,
-        "time step  critical {:.4e} (particle {}), chosen {:.4e} ({:.3} x critical), {}",
-        setup.dt_critical,
-        p.gid[setup.dt_critical_particle],
+        "time step  critical {critical}, chosen {:.4e} ({:.3} x critical), {}",
         sim.dt,
-        sim.dt / setup.dt_critical,
+        sim.dt / setup.dt_limit(),
         sim.integrator.name()
     );
     let _ = writeln!(

@@ -6,12 +6,12 @@ use crate::bars::BarBonds;
 use crate::bonds::BondList;
 use crate::boundary::{Constraint, Load, TEMPERATURE};
 use crate::cells::CellGrid;
-use crate::deck::{DeckError, LoadKind, Region, RunLength, Scene};
+use crate::deck::{CriticalStep, DeckError, LoadKind, Region, RunLength, Scene};
 use crate::decomposition::Domain;
 use crate::geometry;
 use crate::model::{second_order, Model, ModelBuild, ModelVisitor};
 use crate::particles::Particles;
-use crate::simulation::{stable_time_step, Simulation};
+use crate::simulation::{stable_time_step, stable_time_steps, Simulation};
 use std::time::Instant;
 
 /// A simulation built from a deck, with what the deck's checks found.
@@ -20,6 +20,10 @@ pub struct Setup<M: Model> {
     /// Silling–Askari bound and the particle (store index) that sets it.
     pub dt_critical: f64,
     pub dt_critical_particle: usize,
+    /// With `[time] critical_step = "measured"` (explicit runs): the critical step measured on
+    /// the stiffest mode (`spectrum::critical_time_step`; for first-order DOFs still their
+    /// bound), and the force evaluations it took.
+    pub dt_measured: Option<(f64, u64)>,
     pub steps: u64,
     /// Probe name and the store index of the particle nearest to it.
     pub probes: Vec<(String, usize)>,
@@ -35,6 +39,14 @@ pub struct Setup<M: Model> {
     pub solver: crate::deck::SolverSpec,
     /// Calibration factors and prestrain of the bars' own bonds.
     pub bars: BarBonds,
+}
+
+impl<M: Model> Setup<M> {
+    /// The critical step Δt was chosen against: the measured one if the deck asked for it,
+    /// else the Silling–Askari bound.
+    pub fn dt_limit(&self) -> f64 {
+        self.dt_measured.map_or(self.dt_critical, |(dt, _)| dt)
+    }
 }
 
 /// Builds the model named by the deck and hands it to `visitor`.
@@ -175,45 +187,6 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
             "no particle has a bond: the horizon is too small for the particle spacing",
         ));
     }
-    let dt = match scene.time.dt {
-        Some(dt) => {
-            if dt > dt_critical && !scene.time.force_dt {
-                return Err(scene.error(
-                    Some(scene.time_line),
-                    format!(
-                        "[time] dt = {dt:.4e} is above the stable time step {dt_critical:.4e} (Silling–Askari bound, set by particle {} at {:?}); lower dt, use safety_factor, or set force_dt = true to run anyway",
-                        particles.gid[dt_critical_particle], particles.x0[dt_critical_particle]
-                    ),
-                ));
-            }
-            dt
-        }
-        None => scene.time.safety_factor * dt_critical,
-    };
-    let mut steps = match scene.time.length {
-        RunLength::Steps(n) => n,
-        RunLength::Duration(d) => (d / dt).ceil() as u64,
-    };
-    // Relaxation follows the loads through the same time span in `load_steps` equal steps;
-    // a "step" is then a load step and Δt its length in the loads' time.
-    let dt = match scene.solver {
-        crate::deck::SolverSpec::Relaxation { load_steps, .. } => {
-            let span = match scene.time.length {
-                RunLength::Steps(n) => n as f64 * dt,
-                RunLength::Duration(d) => d,
-            };
-            steps = load_steps;
-            span / load_steps as f64
-        }
-        crate::deck::SolverSpec::Explicit => dt,
-    };
-    if steps > 1_000_000_000_000 {
-        return Err(scene.error(
-            Some(scene.time_line),
-            format!("[time] the run would take {steps} steps of {dt:.4e}: shorten the duration"),
-        ));
-    }
-
     // Initial velocities and temperatures.
     let n2 = second_order::<M>();
     for init in &scene.initial {
@@ -343,10 +316,94 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         })
         .collect();
 
-    let mut sim = Simulation::new(model, particles, bonds, dt);
+    let mut sim = Simulation::new(
+        model,
+        particles,
+        bonds,
+        scene.time.safety_factor * dt_critical,
+    );
     sim.constraints = constraints;
     sim.loads = loads;
     sim.integrator = scene.time.integrator;
+
+    // Time step: the bound, or the limit of central differences measured on the stiffest mode
+    // (explicit runs only: relaxation's pseudo time has its own limit).
+    let explicit = matches!(scene.solver, crate::deck::SolverSpec::Explicit);
+    let measured = scene.time.critical_step == CriticalStep::Measured;
+    if measured && !explicit {
+        return Err(scene.error(
+            Some(scene.time_line),
+            "[time] critical_step = \"measured\" is for explicit runs: a quasi-static [solver] has no time step to limit",
+        ));
+    }
+    if measured && !crate::spectrum::measures_critical_step::<M>() {
+        return Err(scene.error(
+            Some(scene.time_line),
+            format!("[time] critical_step = \"measured\" is not offered for model '{}' (rotational degrees of freedom: the measured step disagrees with the empirical limit, docs/stability.md); use the bound", M::NAME),
+        ));
+    }
+    let dt_measured = if measured {
+        let (dt, evaluations) = crate::spectrum::critical_time_step(&mut sim).ok_or_else(|| {
+            scene.error(
+                Some(scene.time_line),
+                "[time] critical_step = \"measured\": no free degree of freedom has a bond, so there is no stiffest mode to measure; use the bound",
+            )
+        })?;
+        // First-order DOFs (temperature) keep their forward-Euler bound.
+        let first = stable_time_steps(&sim.model, &sim.particles, &sim.bonds)[1].0;
+        Some((dt.min(first), evaluations))
+    } else {
+        None
+    };
+    let (limit, limit_name) = match dt_measured {
+        Some((dt, _)) => (dt, "measured on the stiffest mode".to_string()),
+        None => (
+            dt_critical,
+            format!(
+                "Silling–Askari bound, set by particle {} at {:?}",
+                sim.particles.gid[dt_critical_particle], sim.particles.x0[dt_critical_particle]
+            ),
+        ),
+    };
+    let dt = match scene.time.dt {
+        Some(dt) => {
+            if dt > limit && !scene.time.force_dt {
+                return Err(scene.error(
+                    Some(scene.time_line),
+                    format!(
+                        "[time] dt = {dt:.4e} is above the stable time step {limit:.4e} ({limit_name}); lower dt, use safety_factor, or set force_dt = true to run anyway"
+                    ),
+                ));
+            }
+            dt
+        }
+        None => scene.time.safety_factor * limit,
+    };
+    let mut steps = match scene.time.length {
+        RunLength::Steps(n) => n,
+        RunLength::Duration(d) => (d / dt).ceil() as u64,
+    };
+    // Relaxation follows the loads through the same time span in `load_steps` equal steps;
+    // a "step" is then a load step and Δt its length in the loads' time.
+    let dt = match scene.solver {
+        crate::deck::SolverSpec::Relaxation { load_steps, .. } => {
+            let span = match scene.time.length {
+                RunLength::Steps(n) => n as f64 * dt,
+                RunLength::Duration(d) => d,
+            };
+            steps = load_steps;
+            span / load_steps as f64
+        }
+        crate::deck::SolverSpec::Explicit => dt,
+    };
+    if steps > 1_000_000_000_000 {
+        return Err(scene.error(
+            Some(scene.time_line),
+            format!("[time] the run would take {steps} steps of {dt:.4e}: shorten the duration"),
+        ));
+    }
+
+    sim.dt = dt;
     for c in &sim.constraints {
         c.set_velocity(&mut sim.particles, 0.0, dt);
     }
@@ -358,6 +415,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         sim,
         dt_critical,
         dt_critical_particle,
+        dt_measured,
         steps,
         probes,
         seconds,

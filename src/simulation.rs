@@ -95,6 +95,21 @@ impl<M: Model> Simulation<M> {
         }
     }
 
+    /// Whether each second-order DOF of the owned particles (particle-major) is free: held by
+    /// no boundary condition (fixed or driven).
+    pub fn free_dofs(&self) -> Vec<bool> {
+        let n2 = second_order::<M>();
+        let mut free = vec![true; self.particles.n_owned * n2];
+        for c in &self.constraints {
+            for &i in &c.particles {
+                for &k in c.dofs.iter().filter(|&&k| k < n2) {
+                    free[i as usize * n2 + k] = false;
+                }
+            }
+        }
+        free
+    }
+
     /// Forces at the current state, loads and constraint reactions included. Returns the
     /// number of bonds that broke.
     pub fn compute_forces(&mut self) -> usize {
@@ -246,21 +261,35 @@ pub fn stable_time_step<M: Model>(
     p: &Particles<M>,
     bonds: &BondList<M::Bond>,
 ) -> (f64, usize) {
+    let [second, first] = stable_time_steps(model, p, bonds);
+    if first.0 < second.0 {
+        first
+    } else {
+        second
+    }
+}
+
+/// [`stable_time_step`] of the second-order and of the first-order DOFs apart.
+pub fn stable_time_steps<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &BondList<M::Bond>,
+) -> [(f64, usize); 2] {
     let sum = stiffness_sums(model, p, bonds);
     let n2 = second_order::<M>();
-    let mut best = (f64::INFINITY, 0);
+    let mut best = [(f64::INFINITY, 0); 2];
     for (i, s) in sum.iter().enumerate().take(p.n_owned) {
         let inv = p.inv_inertia[i].as_slice();
         for (k, &s) in s.as_slice().iter().enumerate() {
             if s > 0.0 {
                 let inertia = 1.0 / (inv[k] * p.volume[i] * s);
-                let dt = if k < n2 {
-                    (2.0 * inertia).sqrt()
+                let (dt, order) = if k < n2 {
+                    ((2.0 * inertia).sqrt(), 0)
                 } else {
-                    inertia
+                    (inertia, 1)
                 };
-                if dt < best.0 {
-                    best = (dt, i);
+                if dt < best[order].0 {
+                    best[order] = (dt, i);
                 }
             }
         }

@@ -16,6 +16,8 @@ use crate::attributes::Attributes;
 use crate::deck;
 use crate::model::{second_order, Model, ModelVisitor};
 use crate::setup::{self, Setup};
+use crate::simulation::stable_time_steps;
+use crate::spectrum::LANCZOS_STEPS;
 use std::fmt::Write as _;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -215,6 +217,10 @@ fn any_non_finite<M: Model>(s: &Setup<M>) -> bool {
 /// Blow-up: energy (kinetic, or the first-order spread) grown past 100 times its start.
 const GROWTH: f64 = 100.0;
 
+/// How far the measured critical step may lie from the empirical one (relative): the top Ritz
+/// value approaches λ_max from below, and the bisection's blow-up needs a little excess.
+pub const MEASURED_AGREEMENT: f64 = 0.05;
+
 /// The state a trial starts from: the excited particles and the intact bonds (a blown-up trial
 /// breaks bonds and, in steel, leaves plastic history, which must not leak into the next).
 struct Start<M: Model> {
@@ -274,6 +280,11 @@ pub struct CriticalStep {
     /// range held no unstable factor.
     pub lo: f64,
     pub hi: f64,
+    /// The critical step measured on the stiffest mode (`[time] critical_step = "measured"`),
+    /// × bound.
+    pub measured: f64,
+    /// Whether `[time] critical_step = "measured"` is offered for the model (not with rotations).
+    pub offered: bool,
     pub steps: u64,
     pub seconds: f64,
 }
@@ -289,7 +300,7 @@ pub fn critical_step(
     let text = block_deck(model, [n; 3], lattice, f64::INFINITY);
     let scene = deck::parse(&text, "<stress>", "stress").map_err(|e| e.to_string())?;
     let started = Instant::now();
-    let (particles, bound, lo, hi) = setup::with_model(
+    let ((particles, bound, lo, hi, measured), offered) = setup::with_model(
         &scene,
         Bisect {
             scene: &scene,
@@ -305,6 +316,8 @@ pub fn critical_step(
         bound,
         lo,
         hi,
+        measured,
+        offered,
         steps,
         seconds: started.elapsed().as_secs_f64(),
     })
@@ -317,9 +330,13 @@ struct Bisect<'a> {
 }
 
 impl ModelVisitor for Bisect<'_> {
-    type Output = Result<(usize, f64, f64, f64), String>;
+    type Output = Result<((usize, f64, f64, f64, f64), bool), String>;
     fn visit<M: Model>(self, model: M) -> Self::Output {
         let mut s = setup::build(model, self.scene).map_err(|e| e.to_string())?;
+        let first_order = stable_time_steps(&s.sim.model, &s.sim.particles, &s.sim.bonds)[1].0;
+        let measured = crate::spectrum::critical_time_step(&mut s.sim)
+            .map_or(f64::INFINITY, |(dt, _)| dt.min(first_order))
+            / s.dt_critical;
         excite(&mut s, 0.01);
         let start = Start::of(&s);
         let (mut lo, mut hi) = (0.25, 8.0);
@@ -330,7 +347,16 @@ impl ModelVisitor for Bisect<'_> {
             ));
         }
         if stable(&mut s, &start, hi, self.steps) {
-            return Ok((s.sim.particles.n_owned, s.dt_critical, hi, f64::INFINITY));
+            return Ok((
+                (
+                    s.sim.particles.n_owned,
+                    s.dt_critical,
+                    hi,
+                    f64::INFINITY,
+                    measured,
+                ),
+                crate::spectrum::measures_critical_step::<M>(),
+            ));
         }
         // Geometric bisection: the factor's relative precision halves each time.
         for _ in 0..self.halvings {
@@ -341,7 +367,10 @@ impl ModelVisitor for Bisect<'_> {
                 hi = mid;
             }
         }
-        Ok((s.sim.particles.n_owned, s.dt_critical, lo, hi))
+        Ok((
+            (s.sim.particles.n_owned, s.dt_critical, lo, hi, measured),
+            crate::spectrum::measures_critical_step::<M>(),
+        ))
     }
 }
 
@@ -633,7 +662,7 @@ pub fn run(opts: &StressOptions) -> Result<String, String> {
         });
         let _ = writeln!(
             out,
-            "## Critical time step against the Silling–Askari bound\n\n{n}³ lattice sites, m = 3, free block, random initial velocities (and rotation rates, temperatures); blow-up = kinetic energy (or temperature spread) over {GROWTH}× its start within {steps} steps; geometric bisection between 0.25 and 8 × the bound, {halvings} halvings.\n\n| model | lattice | particles | bound Δt (s) | empirical Δt_crit / bound | run time (s) |\n|---|---|---|---|---|---|"
+            "## Critical time step against the Silling–Askari bound\n\n{n}³ lattice sites, m = 3, free block, random initial velocities (and rotation rates, temperatures); blow-up = kinetic energy (or temperature spread) over {GROWTH}× its start within {steps} steps; geometric bisection between 0.25 and 8 × the bound, {halvings} halvings.\n\nThe measured critical step (`[time] critical_step = \"measured\"`) is 2/√λ_max(M⁻¹K) from {LANCZOS_STEPS} Lanczos steps before the excitation; it should agree with the empirical limit.\n\n| model | lattice | particles | bound Δt (s) | empirical Δt_crit / bound | measured Δt_crit / bound | empirical / measured | run time (s) |\n|---|---|---|---|---|---|---|---|"
         );
         for r in rows {
             let r = r?;
@@ -655,13 +684,29 @@ pub fn run(opts: &StressOptions) -> Result<String, String> {
             } else {
                 format!("> {:.1}", r.lo)
             };
+            let empirical = (r.lo * r.hi).sqrt();
+            if r.offered
+                && r.hi.is_finite()
+                && (empirical / r.measured - 1.0).abs() > MEASURED_AGREEMENT
+            {
+                broken_expectations.push(format!(
+                    "{} {}: the measured critical step is {:.3} × the bound, the empirical one {empirical:.3} ×: they differ by more than {:.0} %",
+                    r.model,
+                    r.lattice.name(),
+                    r.measured,
+                    100.0 * MEASURED_AGREEMENT
+                ));
+            }
             let _ = writeln!(
                 out,
-                "| {} | {} | {} | {:.4e} | {ratio} | {:.1} |",
+                "| {} | {} | {} | {:.4e} | {ratio} | {:.3}{} | {:.3} | {:.1} |",
                 r.model,
                 r.lattice.name(),
                 r.particles,
                 r.bound,
+                r.measured,
+                if r.offered { "" } else { " (not offered)" },
+                empirical / r.measured,
                 r.seconds
             );
         }

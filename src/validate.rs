@@ -659,6 +659,7 @@ min = "0 0 0 in"
 max = "{length} {CONCRETE_WIDTH} {CONCRETE_DEPTH} in"
 [time]
 duration = "{ramp_time} s"
+critical_step = "measured"
 {stop}[output]
 progress = false
 history_every = 20

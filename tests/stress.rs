@@ -32,6 +32,28 @@ fn the_bound_is_below_the_measured_critical_step_on_every_lattice() {
 }
 
 #[test]
+fn the_measured_critical_step_is_the_empirical_one() {
+    for lattice in [Lattice::Regular, Lattice::Jittered, Lattice::SteelConcrete] {
+        for model in ["pmb", "concrete", "lps"] {
+            let r = stress::critical_step(model, lattice, 6, 400, 8).unwrap();
+            let empirical = (r.lo * r.hi).sqrt();
+            println!(
+                "{model} {}: empirical {empirical:.3}, measured {:.3} (× bound)",
+                lattice.name(),
+                r.measured
+            );
+            assert!(r.offered);
+            assert!(
+                (empirical / r.measured - 1.0).abs() < stress::MEASURED_AGREEMENT,
+                "{model} {}: empirical {empirical:.3} against measured {:.3}",
+                lattice.name(),
+                r.measured
+            );
+        }
+    }
+}
+
+#[test]
 fn energy_stays_within_its_integration_error_over_a_long_vibration() {
     for model in ["pmb", "lps", "thermal"] {
         let r = stress::drift(model, 5, 4000).unwrap();

@@ -152,6 +152,7 @@ name = "right_bar_end"
 at = "{right_probe} 0 {BAR_OFFSET} in"
 [time]
 duration = "{duration} s"
+critical_step = "measured"
 [output]
 progress = false
 history_every = 10
