@@ -799,17 +799,18 @@ impl Converter {
         if dt.is_some() && t.safety_factor.is_some() {
             return self.err(time_line, "[time] give 'dt' or 'safety_factor', not both");
         }
-        let critical_step =
-            match t.critical_step.as_deref().unwrap_or("bound") {
-                "bound" => CriticalStep::Bound,
-                "measured" => CriticalStep::Measured,
-                other => return self.err(
+        let critical_step = match t.critical_step.as_deref().unwrap_or("bound") {
+            "bound" => CriticalStep::Bound,
+            "measured" => CriticalStep::Measured,
+            other => {
+                return self.err(
                     time_line,
                     format!(
                         "[time] critical_step must be \"bound\" or \"measured\" (got \"{other}\")"
                     ),
-                ),
-            };
+                )
+            }
+        };
         let stop_at_broken_bonds = match t.stop_at_broken_bonds {
             None => 0,
             Some(n) if n >= 1 => n as u64,

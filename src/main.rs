@@ -57,9 +57,10 @@ enum Cmd {
         /// Output directory.
         #[arg(long, default_value = "out/validate")]
         output: PathBuf,
-        /// Threads per case.
-        #[arg(long, default_value_t = 1)]
-        threads: usize,
+        /// Threads per explicit or ADR case (default: the cores available; the implicit solve
+        /// runs on one).
+        #[arg(long)]
+        threads: Option<usize>,
         /// Instead of the cases: ADR against an explicit load ramp on the LPS cantilever
         /// (force evaluations to the same residual).
         #[arg(long)]
@@ -160,6 +161,11 @@ enum Cmd {
     },
 }
 
+/// The cores this process may use.
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let mut interrupted = false;
@@ -213,7 +219,8 @@ fn main() -> ExitCode {
             compare_adr: true,
             ramp_periods,
             ..
-        } => pdq::validate::compare_adr(&output, threads, ramp_periods).map(|s| print!("{s}")),
+        } => pdq::validate::compare_adr(&output, threads.unwrap_or_else(cores), ramp_periods)
+            .map(|s| print!("{s}")),
         Cmd::Validate {
             quick: _,
             full,
@@ -232,7 +239,7 @@ fn main() -> ExitCode {
             },
             only: cases,
             output,
-            threads,
+            threads: threads.unwrap_or_else(cores),
         })
         .and_then(|(table, ok)| {
             print!("{table}");

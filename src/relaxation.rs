@@ -98,12 +98,6 @@ pub fn fictitious_mass<M: Model>(sim: &mut Simulation<M>) -> FictitiousMass {
     for (f, &b) in free.iter_mut().zip(&shape) {
         *f &= b > 0.0;
     }
-    // Rotational DOFs keep the book's masses: with the measured masses the quick micropolar
-    // simply supported beam stalled at a relative residual of 3–20 over 20,000 iterations
-    // without diverging (its cantilever converged); not understood yet.
-    if n2 > 3 {
-        free.iter_mut().for_each(|f| *f = false);
-    }
     let (lambda_max, evaluations) = match crate::spectrum::stiffest_mode(sim, &shape, &free) {
         Some((l, e)) if l.is_finite() && l > 0.0 => (Some(l), e),
         Some((_, e)) => (None, e),

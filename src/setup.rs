@@ -336,12 +336,6 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
             "[time] critical_step = \"measured\" is for explicit runs: a quasi-static [solver] has no time step to limit",
         ));
     }
-    if measured && !crate::spectrum::measures_critical_step::<M>() {
-        return Err(scene.error(
-            Some(scene.time_line),
-            format!("[time] critical_step = \"measured\" is not offered for model '{}' (rotational degrees of freedom: the measured step disagrees with the empirical limit, docs/stability.md); use the bound", M::NAME),
-        ));
-    }
     let dt_measured = if measured {
         let (dt, evaluations) = crate::spectrum::critical_time_step(&mut sim).ok_or_else(|| {
             scene.error(

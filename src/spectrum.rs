@@ -25,15 +25,6 @@ pub const LANCZOS_STEPS: usize = 30;
 /// coordinates' size at most).
 const PROBE_DISPLACEMENT: f64 = 1e-6;
 
-/// Whether [`critical_time_step`] is trusted for the model: not with rotational DOFs. For
-/// micropolar the measured step is 1.4–1.5× the empirical limit on every lattice of `pdq
-/// stress` (the Lanczos estimate converged: the same at 150 steps), so the stiffness seen
-/// through force differences misses what makes its rotations unstable; the same models'
-/// relaxation keeps the book's masses. Not understood yet.
-pub fn measures_critical_step<M: Model>() -> bool {
-    second_order::<M>() <= 3
-}
-
 /// The critical time step of central differences (velocity Verlet and semi-implicit Euler
 /// alike), 2/√λ_max(M⁻¹K) over the second-order DOFs that no boundary condition holds, with M
 /// the particles' masses (and rotational inertias), measured about the scene's current state;
@@ -93,24 +84,33 @@ pub fn stiffest_mode<M: Model>(
     sim.compute_forces();
     let f0 = forces(sim);
     let mut evaluations = 1u64;
+    let mut moved: Vec<usize> = dofs.iter().map(|&d| d / n2).collect();
+    moved.dedup();
     // q ↦ W^-½ K W^-½ q.
     let mut apply = |sim: &mut Simulation<M>, q: &[f64]| -> Vec<f64> {
         let y: Vec<f64> = q.iter().zip(&scale).map(|(q, s)| q * s).collect();
-        // Sized on the translations, so that rotations move by a like amount times 1/length.
+        // No translation beyond PROBE_DISPLACEMENT × the shortest bond, no rotation beyond
+        // PROBE_DISPLACEMENT radians: both stay linear whichever dominates the vector.
         let largest = |translations: bool| {
             dofs.iter()
                 .zip(&y)
-                .filter(|(&d, _)| !translations || d % n2 < 3)
+                .filter(|(&d, _)| (d % n2 < 3) == translations)
                 .fold(0.0f64, |m, (_, y)| m.max(y.abs()))
         };
-        let mut top = largest(true);
-        if top == 0.0 {
-            top = largest(false);
-        }
-        let h = PROBE_DISPLACEMENT * shortest / top.max(f64::MIN_POSITIVE);
+        // q is a unit vector, so at least one of the two is non-zero and h is finite.
+        let h = PROBE_DISPLACEMENT * (shortest / largest(true)).min(1.0 / largest(false));
+        // Through the model's drift with velocities h·y over a unit time, as the integrator
+        // moves particles: rotations compose into the orientation the bond loop reads.
+        let mut velocity = vec![0.0; sim.particles.n_owned * n2];
         for (&d, y) in dofs.iter().zip(&y) {
-            sim.particles.alter[d / n2].as_mut_slice()[d % n2] =
-                saved.0[d / n2].as_slice()[d % n2] + h * y;
+            velocity[d] = h * y;
+        }
+        for &i in &moved {
+            let mut a = saved.0[i];
+            a.as_mut_slice()[n2..2 * n2].copy_from_slice(&velocity[i * n2..(i + 1) * n2]);
+            sim.model.drift(&mut a, 1.0);
+            a.as_mut_slice()[n2..2 * n2].copy_from_slice(&saved.0[i].as_slice()[n2..2 * n2]);
+            sim.particles.alter[i] = a;
         }
         sim.compute_forces();
         evaluations += 1;
