@@ -271,13 +271,13 @@ fn blow_up<M: Model>(
         "relaxation diverged: check the loads, supports and materials".to_string()
     } else if ratio > 1.0 {
         format!(
-            "the time step is {ratio:.2} × the critical step ({:.4e} against {:.4e}): lower dt or drop force_dt",
-            cube.sim.dt, plan.dt_critical
+            "the time step is {ratio:.2} × the {} ({:.4e} against {:.4e}): lower dt or drop force_dt",
+            plan.dt_critical_name, cube.sim.dt, plan.dt_critical
         )
     } else {
         format!(
-            "the time step is within the critical step ({ratio:.2} × {:.4e}): check the material's stiffness and density, and the loads and prescribed velocities",
-            plan.dt_critical
+            "the time step is within the {} ({ratio:.2} × {:.4e}): check the material's stiffness and density, and the loads and prescribed velocities",
+            plan.dt_critical_name, plan.dt_critical
         )
     };
     format!(
@@ -374,8 +374,9 @@ struct Plan {
     first_step: u64,
     /// A quasi-static solver, if the deck asks for one (else explicit time steps).
     relaxation: Option<QuasiStatic>,
-    /// For the blow-up diagnosis: the stable time step and the material names.
+    /// For the blow-up diagnosis: the stable time step, what it is, and the material names.
     dt_critical: f64,
+    dt_critical_name: &'static str,
     material_names: Vec<String>,
     spacing: f64,
     checkpoints: CheckpointPlan,
@@ -884,7 +885,7 @@ fn run_setup<M: Model>(
                             "relaxation fictitious mass from the stiffest mode, λ_max = {l:.4} of the Gershgorin bound's 2 ({} force evaluations)",
                             mass.evaluations
                         ),
-                        None => eprintln!("relaxation fictitious mass: the book's (rotational DOFs, or no free DOF with a bond)"),
+                        None => eprintln!("relaxation fictitious mass: the book's (no free DOF with a bond to estimate from)"),
                     }
                 }
                 Some(QuasiStatic::Adr {
@@ -941,6 +942,11 @@ fn run_setup<M: Model>(
         first_step: resume.map_or(0, |c| c.step),
         relaxation: relaxation.clone(),
         dt_critical: setup.dt_limit(),
+        dt_critical_name: if setup.dt_measured.is_some() {
+            "measured critical step"
+        } else {
+            "stable bound"
+        },
         material_names: scene.materials.iter().map(|m| m.name.clone()).collect(),
         spacing: scene.spacing,
         checkpoints: CheckpointPlan {

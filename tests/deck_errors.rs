@@ -528,6 +528,80 @@ fn dt_above_stable_time_step_line() {
     assert_rejected("dt_large_line", &deck, &["stable time step"], Some(line));
 }
 
+/// A critical step that is neither the bound nor measured.
+#[test]
+fn unknown_critical_step() {
+    let deck = edit(
+        "safety_factor = 0.8",
+        "safety_factor = 0.8\ncritical_step = \"guessed\"",
+    );
+    let line = line_of(&deck, "[time]");
+    assert_rejected(
+        "critical_step",
+        &deck,
+        &["critical_step", "guessed", "bound", "measured"],
+        Some(line),
+    );
+}
+
+/// The measured critical step with a quasi-static solver, which has no time step.
+#[test]
+fn measured_critical_step_with_relaxation() {
+    let deck = edit(
+        "safety_factor = 0.8",
+        "safety_factor = 0.8\ncritical_step = \"measured\"",
+    ) + "[solver]\nkind = \"adr\"\n";
+    let line = line_of(&deck, "[time]");
+    assert_rejected(
+        "critical_step_adr",
+        &deck,
+        &["critical_step", "explicit"],
+        Some(line),
+    );
+}
+
+/// The measured critical step is accepted, shown by `pdq check` with the bound, and above it
+/// (the bound is 1.4–2.4× below the limit, docs/stability.md); a dt between the two passes.
+#[test]
+fn measured_critical_step_is_shown_and_above_the_bound() {
+    let deck = edit(
+        "safety_factor = 0.8",
+        "safety_factor = 0.8\ncritical_step = \"measured\"",
+    );
+    let out = check("critical_step_measured", &deck);
+    assert!(out.success, "{}", out.stderr);
+    let line = out
+        .stdout
+        .lines()
+        .chain(out.stderr.lines())
+        .find(|l| l.starts_with("time step"))
+        .expect("a time step line")
+        .to_string();
+    assert!(line.contains("measured on the stiffest mode"), "{line}");
+    let number_after = |key: &str| -> f64 {
+        let rest = &line[line.find(key).expect(key) + key.len()..];
+        rest.split(|c: char| c == ' ' || c == ',')
+            .find(|w| !w.is_empty())
+            .and_then(|w| w.parse().ok())
+            .unwrap_or_else(|| panic!("no number after {key:?} in {line}"))
+    };
+    let (measured, bound) = (number_after("critical "), number_after("bound is "));
+    assert!(
+        measured > 1.3 * bound && measured < 2.5 * bound,
+        "measured {measured:e} against bound {bound:e}: {line}"
+    );
+    // A dt between the bound and the measured limit is refused by the bound alone.
+    let dt = 0.5 * (measured + bound);
+    let deck = edit(
+        "safety_factor = 0.8",
+        &format!("dt = \"{dt:e} s\"\ncritical_step = \"measured\""),
+    );
+    let out = check("critical_step_measured_dt", &deck);
+    assert!(out.success, "{}", out.stderr);
+    let deck = edit("safety_factor = 0.8", &format!("dt = \"{dt:e} s\""));
+    assert_rejected("critical_step_bound_dt", &deck, &["stable time step"], None);
+}
+
 /// An integrator PDQ does not have.
 #[test]
 fn unknown_integrator() {
