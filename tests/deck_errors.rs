@@ -580,7 +580,7 @@ fn measured_critical_step_is_shown_and_above_the_bound() {
     assert!(line.contains("measured on the stiffest mode"), "{line}");
     let number_after = |key: &str| -> f64 {
         let rest = &line[line.find(key).expect(key) + key.len()..];
-        rest.split(|c: char| c == ' ' || c == ',')
+        rest.split([' ', ','])
             .find(|w| !w.is_empty())
             .and_then(|w| w.parse().ok())
             .unwrap_or_else(|| panic!("no number after {key:?} in {line}"))
