@@ -11,7 +11,7 @@ use crate::decomposition::Domain;
 use crate::geometry;
 use crate::model::{second_order, Model, ModelBuild, ModelVisitor};
 use crate::particles::Particles;
-use crate::simulation::{stable_time_step, stable_time_steps, Simulation};
+use crate::simulation::{stable_time_step, Simulation};
 use std::time::Instant;
 
 /// A simulation built from a deck, with what the deck's checks found.
@@ -337,15 +337,12 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         ));
     }
     let dt_measured = if measured {
-        let (dt, evaluations) = crate::spectrum::critical_time_step(&mut sim).ok_or_else(|| {
+        Some(crate::spectrum::critical_time_step(&mut sim).ok_or_else(|| {
             scene.error(
                 Some(scene.time_line),
                 "[time] critical_step = \"measured\": no free degree of freedom has a bond, so there is no stiffest mode to measure; use the bound",
             )
-        })?;
-        // First-order DOFs (temperature) keep their forward-Euler bound.
-        let first = stable_time_steps(&sim.model, &sim.particles, &sim.bonds)[1].0;
-        Some((dt.min(first), evaluations))
+        })?)
     } else {
         None
     };

@@ -15,7 +15,7 @@
 
 use crate::attributes::Attributes;
 use crate::model::{second_order, Model};
-use crate::simulation::Simulation;
+use crate::simulation::{stable_time_steps, Simulation};
 
 /// Krylov steps of the estimate (one force evaluation each, plus one at the start).
 pub const LANCZOS_STEPS: usize = 30;
@@ -28,8 +28,10 @@ const PROBE_DISPLACEMENT: f64 = 1e-6;
 /// The critical time step of central differences (velocity Verlet and semi-implicit Euler
 /// alike), 2/√λ_max(M⁻¹K) over the second-order DOFs that no boundary condition holds, with M
 /// the particles' masses (and rotational inertias), measured about the scene's current state;
-/// and the force evaluations it took. `None` when no free DOF has a bond.
+/// first-order DOFs (temperature) keep their forward-Euler bound. And the force evaluations
+/// it took. `None` when no free DOF has a bond.
 pub fn critical_time_step<M: Model>(sim: &mut Simulation<M>) -> Option<(f64, u64)> {
+    let first_order = stable_time_steps(&sim.model, &sim.particles, &sim.bonds)[1].0;
     let n2 = second_order::<M>();
     let p = &sim.particles;
     let mass: Vec<f64> = p.inv_inertia[..p.n_owned]
@@ -38,7 +40,7 @@ pub fn critical_time_step<M: Model>(sim: &mut Simulation<M>) -> Option<(f64, u64
         .collect();
     let free = sim.free_dofs();
     match stiffest_mode(sim, &mass, &free) {
-        Some((l, e)) if l.is_finite() && l > 0.0 => Some((2.0 / l.sqrt(), e)),
+        Some((l, e)) if l.is_finite() && l > 0.0 => Some(((2.0 / l.sqrt()).min(first_order), e)),
         _ => None,
     }
 }

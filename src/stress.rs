@@ -16,7 +16,6 @@ use crate::attributes::Attributes;
 use crate::deck;
 use crate::model::{second_order, Model, ModelVisitor};
 use crate::setup::{self, Setup};
-use crate::simulation::stable_time_steps;
 use crate::spectrum::LANCZOS_STEPS;
 use std::fmt::Write as _;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -330,9 +329,8 @@ impl ModelVisitor for Bisect<'_> {
     type Output = Result<(usize, f64, f64, f64, f64), String>;
     fn visit<M: Model>(self, model: M) -> Self::Output {
         let mut s = setup::build(model, self.scene).map_err(|e| e.to_string())?;
-        let first_order = stable_time_steps(&s.sim.model, &s.sim.particles, &s.sim.bonds)[1].0;
         let measured = crate::spectrum::critical_time_step(&mut s.sim)
-            .map_or(f64::INFINITY, |(dt, _)| dt.min(first_order))
+            .map_or(f64::INFINITY, |(dt, _)| dt)
             / s.dt_critical;
         excite(&mut s, 0.01);
         let start = Start::of(&s);
