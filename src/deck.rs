@@ -223,6 +223,7 @@ struct TimeSection {
     dt: Option<Time>,
     safety_factor: Option<f64>,
     critical_step: Option<String>,
+    static_until: Option<Time>,
     force_dt: Option<bool>,
     integrator: Option<String>,
     stop_at_broken_bonds: Option<i64>,
@@ -349,6 +350,9 @@ pub struct TimeSpec {
     pub safety_factor: f64,
     /// What Δt_crit is: the Silling–Askari bound, or measured from the stiffest mode.
     pub critical_step: CriticalStep,
+    /// Reach this time by one static (implicit) solve, then step explicitly from rest there
+    /// (`[time] static_until`); `None`: step from time 0.
+    pub static_until: Option<f64>,
     pub force_dt: bool,
     pub integrator: Integrator,
     /// End the run after the first step (load step) at which at least this many bonds have
@@ -811,6 +815,24 @@ impl Converter {
                 )
             }
         };
+        let static_until = match t.static_until.map(|d| d.value(sys)) {
+            None => None,
+            Some(s) if !(s.is_finite() && s > 0.0) => {
+                return self.err(
+                    time_line,
+                    format!("[time] static_until must be a time > 0 (got {s})"),
+                );
+            }
+            Some(s) => match length {
+                RunLength::Duration(d) if s >= d => {
+                    return self.err(
+                        time_line,
+                        format!("[time] static_until = {s:e} is not before the end of the run (duration {d:e}): nothing would be left to step"),
+                    );
+                }
+                _ => Some(s),
+            },
+        };
         let stop_at_broken_bonds = match t.stop_at_broken_bonds {
             None => 0,
             Some(n) if n >= 1 => n as u64,
@@ -1068,6 +1090,7 @@ impl Converter {
                 dt,
                 safety_factor,
                 critical_step,
+                static_until,
                 force_dt: t.force_dt.unwrap_or(false),
                 integrator,
                 stop_at_broken_bonds,

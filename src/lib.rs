@@ -36,6 +36,7 @@ pub mod shuffle;
 pub mod signals;
 pub mod simulation;
 pub mod spectrum;
+pub mod static_start;
 pub mod stress;
 pub mod timing;
 pub mod units;

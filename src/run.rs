@@ -901,8 +901,25 @@ fn run_setup<M: Model>(
         Some(from) => Some(resume_from(&mut setup, from, scene_hash)?),
         None => None,
     };
-    let resume = resume.as_ref();
-    if let (Some(c), false) = (resume, opts.quiet) {
+    // A static start is handed to the procCubes as a restart at step 0 is; a restart from a
+    // checkpoint has passed it already.
+    let static_start = match (&resume, scene.time.static_until) {
+        (None, Some(until)) => {
+            let walls = opts.walls.unwrap_or(scene.parallel.walls);
+            let s = crate::static_start::solve(&setup, until, walls, scene_hash, &scene.file)
+                .map_err(|e| format!("{}:{}: {e}", scene.file, scene.time_line))?;
+            s.checkpoint.restore_particles(&mut setup);
+            Some(s)
+        }
+        _ => None,
+    };
+    let resume = resume
+        .as_ref()
+        .or(static_start.as_ref().map(|s| &s.checkpoint));
+    if let (Some(s), false) = (&static_start, opts.quiet) {
+        eprintln!("{}", s.describe());
+    }
+    if let (Some(c), false) = (resume.filter(|_| static_start.is_none()), opts.quiet) {
         eprintln!(
             "restart    from step {} (t = {:.6e}) of {}: {} broken bonds",
             c.step,
@@ -1189,11 +1206,18 @@ fn describe<M: Model>(setup: &Setup<M>, scene: &Scene) -> String {
         sim.dt / setup.dt_limit(),
         sim.integrator.name()
     );
+    let start = scene.time.static_until.unwrap_or(0.0);
+    if start > 0.0 {
+        let _ = writeln!(
+            s,
+            "static     start at t = {start:.4e}: supports and loads there, equilibrium by the implicit solve, at rest"
+        );
+    }
     let _ = writeln!(
         s,
         "run        {} steps to t = {:.4e}; {} boundary conditions, {} loads, {} probes",
         setup.steps,
-        setup.steps as f64 * sim.dt,
+        start + setup.steps as f64 * sim.dt,
         sim.constraints.len(),
         sim.loads.len(),
         setup.probes.len()

@@ -370,9 +370,13 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         }
         None => scene.time.safety_factor * limit,
     };
+    if let Some(until) = scene.time.static_until {
+        static_start_allowed::<M>(scene, until)?;
+    }
+    // A static start reaches `static_until` without steps; the steps follow it.
     let mut steps = match scene.time.length {
         RunLength::Steps(n) => n,
-        RunLength::Duration(d) => (d / dt).ceil() as u64,
+        RunLength::Duration(d) => ((d - scene.time.static_until.unwrap_or(0.0)) / dt).ceil() as u64,
     };
     // Relaxation follows the loads through the same time span in `load_steps` equal steps;
     // a "step" is then a load step and Δt its length in the loads' time.
@@ -418,6 +422,39 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         solver: scene.solver.clone(),
         bars,
     })
+}
+
+/// Refuses a static start (`[time] static_until`) that cannot be made: under a quasi-static
+/// solver (which has no explicit steps to start), with initial velocities (it starts at
+/// rest), or for a model the implicit solve cannot take.
+fn static_start_allowed<M: Model>(scene: &Scene, until: f64) -> Result<(), DeckError> {
+    let line = Some(scene.time_line);
+    if !matches!(scene.solver, crate::deck::SolverSpec::Explicit) {
+        return Err(scene.error(
+            line,
+            "[time] static_until starts an explicit run from a static solve; with a quasi-static [solver] every load step is static already: leave it out",
+        ));
+    }
+    if let Some(i) = scene
+        .initial
+        .iter()
+        .find(|i| i.velocity.is_some() || i.angular_velocity.is_some())
+    {
+        return Err(scene.error(
+            Some(i.line),
+            format!("[[initial]] velocities cannot be combined with [time] static_until = {until:e}: the static start begins the run at rest"),
+        ));
+    }
+    if M::FIRST_ORDER > 0 {
+        return Err(scene.error(
+            line,
+            format!(
+                "[time] static_until: the static start solves for mechanical equilibrium, and model '{}' has temperature (first-order degrees of freedom); leave it out",
+                M::NAME
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The bars' calibration factors (bond-based models) and prestrained bond histories; see
