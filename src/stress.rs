@@ -15,11 +15,10 @@
 use crate::attributes::Attributes;
 use crate::deck;
 use crate::model::{second_order, Model, ModelVisitor};
+use crate::parallel::side_by_side;
 use crate::setup::{self, Setup};
 use crate::spectrum::LANCZOS_STEPS;
 use std::fmt::Write as _;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Mutex;
 use std::time::Instant;
 
 #[derive(Clone, Debug)]
@@ -579,32 +578,6 @@ pub fn failure(model: &str, case: Failure, steps: u64) -> Result<FailureRun, Str
         }
     }
     setup::with_model(&scene, Visit(&scene, case, steps, n)).map_err(|e| e.to_string())?
-}
-
-/// Runs `jobs` on `threads` threads, results in job order.
-fn side_by_side<T: Send, J: Sync>(
-    jobs: &[J],
-    threads: usize,
-    work: impl Fn(&J) -> T + Sync,
-) -> Vec<T> {
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<T>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..threads.clamp(1, jobs.len().max(1)) {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, Ordering::Relaxed);
-                let Some(job) = jobs.get(k) else { break };
-                let r = work(job);
-                results.lock().unwrap()[k] = Some(r);
-            });
-        }
-    });
-    results
-        .into_inner()
-        .unwrap()
-        .into_iter()
-        .map(|r| r.expect("every job ran"))
-        .collect()
 }
 
 /// Runs the stress tests and returns the report (Markdown tables).

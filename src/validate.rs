@@ -1147,7 +1147,7 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
     // cases are small, so they run side by side, `threads` at a time, while the others get
     // every thread one after another; at --full a factored tangent can fill the machine alone.
     let is_implicit = |c: &Case| c.deck.contains("kind = \"implicit\"");
-    let side_by_side = if opts.level == Level::Quick {
+    let at_once = if opts.level == Level::Quick {
         threads
     } else {
         1
@@ -1167,21 +1167,8 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
         .filter(|&k| is_implicit(chosen[k]))
         .collect();
     implicit.sort_by_key(|&k| chosen[k].kind != Kind::Strength);
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let done = std::sync::Mutex::new(Vec::new());
-    std::thread::scope(|scope| {
-        for _ in 0..side_by_side.max(1).min(implicit.len()) {
-            scope.spawn(|| loop {
-                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(&index) = implicit.get(k) else { break };
-                let outcome = run_one(chosen[index], 1);
-                done.lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .push((index, outcome));
-            });
-        }
-    });
-    for (index, outcome) in done.into_inner().unwrap_or_else(|e| e.into_inner()) {
+    let solved = crate::parallel::side_by_side(&implicit, at_once, |&k| run_one(chosen[k], 1));
+    for (&index, outcome) in implicit.iter().zip(solved) {
         slots[index] = Some(outcome?);
     }
     for (index, case) in chosen.iter().enumerate() {
