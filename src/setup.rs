@@ -445,6 +445,12 @@ fn static_start_allowed<M: Model>(scene: &Scene, until: f64) -> Result<(), DeckE
             format!("[[initial]] velocities cannot be combined with [time] static_until = {until:e}: the static start begins the run at rest"),
         ));
     }
+    if scene.periodic.iter().any(|&p| p) {
+        return Err(scene.error(
+            line,
+            "[time] static_until: the static start's implicit solve does not handle periodic axes (it finds who feels whom from reference positions); leave static_until out",
+        ));
+    }
     if M::FIRST_ORDER > 0 {
         return Err(scene.error(
             line,

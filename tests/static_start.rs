@@ -211,6 +211,12 @@ fn what_a_static_start_cannot_do_is_refused_on_the_time_line() {
         ),
     );
     assert!(e.contains("temperature"), "{e}");
+    // With periodic axes.
+    let e = refused(&text.replace(
+        "spacing = \"1 mm\"",
+        "spacing = \"1 mm\"\nperiodic = [\"x\"]",
+    ));
+    assert!(e.contains("periodic"), "{e}");
     // A load the structure cannot stand: the static solve does not converge.
     let e = refused(&text.replace("critical_stretch = 0.05", "critical_stretch = 1e-7"));
     assert!(
