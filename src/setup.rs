@@ -426,7 +426,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
 
 /// Refuses a static start (`[time] static_until`) that cannot be made: under a quasi-static
 /// solver (which has no explicit steps to start), with initial velocities (it starts at
-/// rest), or for a model the implicit solve cannot take.
+/// rest), with periodic axes or temperature (which the implicit solve does not take).
 fn static_start_allowed<M: Model>(scene: &Scene, until: f64) -> Result<(), DeckError> {
     let line = Some(scene.time_line);
     if !matches!(scene.solver, crate::deck::SolverSpec::Explicit) {
