@@ -47,6 +47,22 @@ impl History {
         }
     }
 
+    /// ∫ factor dt from `a` to `b` (a ≤ b), exactly: the factor is linear between its knots,
+    /// so the trapezoid rule over the pieces between them is exact.
+    pub fn integral(&self, a: f64, b: f64) -> f64 {
+        let knots: Vec<f64> = match self {
+            History::Constant => Vec::new(),
+            History::Ramp { duration } => vec![0.0, *duration],
+            History::Table(points) => points.iter().map(|p| p.0).collect(),
+        };
+        let mut ts = vec![a];
+        ts.extend(knots.into_iter().filter(|&t| t > a && t < b));
+        ts.push(b);
+        ts.windows(2)
+            .map(|w| 0.5 * (w[1] - w[0]) * (self.factor(w[0]) + self.factor(w[1])))
+            .sum()
+    }
+
     /// Checks the description is usable; the message names what is wrong.
     pub fn validate(&self) -> Result<(), String> {
         match self {
@@ -137,6 +153,9 @@ impl Constraint {
     /// and first-order values to their targets at `t + dt`.
     pub fn set_drift_velocity<M: Model>(&self, p: &mut Particles<M>, t: f64, dt: f64) {
         let n = second_order::<M>();
+        // A velocity's mean over the step moves the support as far as its history does, also
+        // over a step that spans a corner of the history (a static start's one long step).
+        let mean_factor = self.history.integral(t, t + dt) / dt;
         for &i in &self.particles {
             let i = i as usize;
             let x0 = p.x0[i];
@@ -150,7 +169,7 @@ impl Constraint {
                 }
                 a[n + d] = match &self.motion {
                     Motion::Fixed => 0.0,
-                    Motion::Velocity(v) => v[k] * self.history.factor(t + 0.5 * dt),
+                    Motion::Velocity(v) => v[k] * mean_factor,
                     Motion::Displacement(u) => {
                         let reference = if d < 3 { x0[d] } else { 0.0 };
                         (reference + u[k] * self.history.factor(t + dt) - a[d]) / dt
@@ -230,6 +249,13 @@ mod tests {
         assert_eq!(t.factor(0.5), 1.0);
         assert_eq!(t.factor(2.0), 0.0);
         assert_eq!(t.factor(9.0), -2.0);
+        // Integrals across corners: the ramp is ½ over its 2 s, then 1 per second.
+        assert_eq!(r.integral(0.0, 3.0), 2.0);
+        assert_eq!(r.integral(1.0, 2.0), 0.75);
+        assert_eq!(History::Constant.integral(1.0, 4.0), 3.0);
+        // 1 (0 to 1) + 0 (1 to 3) − 2 × 2 (held after 3).
+        assert_eq!(t.integral(0.0, 5.0), -3.0);
+        assert_eq!(t.integral(-1.0, 0.5), 0.25);
         assert!(History::Table(vec![(1.0, 0.0), (1.0, 1.0)])
             .validate()
             .is_err());

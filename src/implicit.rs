@@ -222,7 +222,7 @@ fn check_factor_memory(lower: &SparseColMat<usize, f64>, free: usize) -> Result<
     if needed > FACTOR_MEMORY_SHARE * available {
         let gib = |b: f64| b / (1u64 << 30) as f64;
         return Err(format!(
-            "the implicit solve's factored tangent would need about {:.1} GiB ({} nonzeros over {free} free DOFs), more than the {:.1} GiB of memory available: use [solver] kind = \"adr\" (memory in proportion to the particles), or a coarser lattice",
+            "the implicit solve's factored tangent would need about {:.1} GiB ({} nonzeros over {free} free DOFs), more than the {:.1} GiB of memory available",
             gib(needed),
             symbolic.len_val(),
             gib(FACTOR_MEMORY_SHARE * available)
@@ -302,7 +302,7 @@ fn factor(
                 let a = SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &full)
                     .map_err(|e| format!("assembling the tangent stiffness: {e:?}"))?;
                 let lu = a.sp_lu().map_err(|e| {
-                    format!("the tangent stiffness is singular ({e:?}): the supports leave a rigid-body motion or a loose particle free; support the body or use kind = \"adr\"")
+                    format!("the tangent stiffness is singular ({e:?}): the supports leave a rigid-body motion or a loose particle free; support the body")
                 })?;
                 (Factor::Lu(Box::new(lu)), "LU")
             }
@@ -328,7 +328,7 @@ impl<M: Model> Cube<M> {
         let n2 = second_order::<M>();
         let n = self.sim.particles.n_owned;
         if self.layout.domain.periodic.iter().any(|&p| p) {
-            return Err("the implicit solve does not handle periodic axes (it finds who feels whom from reference positions); use kind = \"adr\"".into());
+            return Err("the implicit solve does not handle periodic axes (it finds who feels whom from reference positions)".into());
         }
         if self.sim.particles.len() != n || self.sim.exchange.transport().size() != 1 {
             return Err("the implicit solve runs on one procCube (--threads 1, no mpirun): the tangent is assembled and factored in one process".into());

@@ -372,6 +372,8 @@ struct Plan {
     layout: String,
     /// The step the loop starts from: 0, or the step of the checkpoint it resumes.
     first_step: u64,
+    /// Force evaluations of the static start (`[time] static_until`), 0 without one.
+    static_evaluations: u64,
     /// A quasi-static solver, if the deck asks for one (else explicit time steps).
     relaxation: Option<QuasiStatic>,
     /// For the blow-up diagnosis: the stable time step, what it is, and the material names.
@@ -456,11 +458,13 @@ fn drive<M: Model>(
     let mut checkpoints: Vec<(PathBuf, u64, f64)> = Vec::new();
     let mut last_checkpoint = Instant::now();
     let mut interrupted = None;
-    // The fictitious mass's estimate counts: it is force evaluations the solve needed.
-    let estimate = match &plan.relaxation {
-        Some(QuasiStatic::Adr { mass, .. }) => mass.evaluations,
-        _ => 0,
-    };
+    // The fictitious mass's estimate and a static start count: force evaluations the run
+    // needed.
+    let estimate = plan.static_evaluations
+        + match &plan.relaxation {
+            Some(QuasiStatic::Adr { mass, .. }) => mass.evaluations,
+            _ => 0,
+        };
     let (mut evaluations, mut converged) = (estimate, 0u64);
     // Grows (doubles) only if relaxation diverges with the estimated masses.
     let mut mass_scale = 1.0f64;
@@ -500,12 +504,17 @@ fn drive<M: Model>(
                 Some(QuasiStatic::Implicit {
                     tolerance,
                     max_iterations,
-                }) => Some(cube.implicit_step(
-                    &mut tangent,
-                    *tolerance,
-                    *max_iterations,
-                    plan.stop_at_broken,
-                )?),
+                }) => Some(
+                    cube.implicit_step(
+                        &mut tangent,
+                        *tolerance,
+                        *max_iterations,
+                        plan.stop_at_broken,
+                    )
+                    .map_err(|e| {
+                        format!("{e} (or use [solver] kind = \"adr\", which assembles no tangent)")
+                    })?,
+                ),
             };
             if let Some(r) = r {
                 evaluations += r.iterations;
@@ -898,7 +907,12 @@ fn run_setup<M: Model>(
     };
     let scene_hash = checkpoint::scene_hash(&setup, scene);
     let resume = match opts.restart.as_ref().or(scene.output.restart.as_ref()) {
-        Some(from) => Some(resume_from(&mut setup, from, scene_hash)?),
+        Some(from) => Some(resume_from(
+            &mut setup,
+            from,
+            scene_hash,
+            scene.time.static_until.unwrap_or(0.0),
+        )?),
         None => None,
     };
     // A static start is handed to the procCubes as a restart at step 0 is; a restart from a
@@ -906,8 +920,16 @@ fn run_setup<M: Model>(
     let static_start = match (&resume, scene.time.static_until) {
         (None, Some(until)) => {
             let walls = opts.walls.unwrap_or(scene.parallel.walls);
+            let at = |e: String| format!("{}:{}: {e}", scene.file, scene.time_line);
             let s = crate::static_start::solve(&setup, until, walls, scene_hash, &scene.file)
-                .map_err(|e| format!("{}:{}: {e}", scene.file, scene.time_line))?;
+                .map_err(at)?;
+            let stop = scene.time.stop_at_broken_bonds;
+            if stop > 0 && s.broken as u64 >= stop {
+                return Err(at(format!(
+                    "[time] the static start to static_until = {until:e} broke {} bonds, already as many as stop_at_broken_bonds = {stop}: the run would stop before it began; start earlier",
+                    s.broken
+                )));
+            }
             s.checkpoint.restore_particles(&mut setup);
             Some(s)
         }
@@ -916,9 +938,13 @@ fn run_setup<M: Model>(
     let resume = resume
         .as_ref()
         .or(static_start.as_ref().map(|s| &s.checkpoint));
-    if let (Some(s), false) = (&static_start, opts.quiet) {
-        eprintln!("{}", s.describe());
-    }
+    // Said after the run's header (`prepare`), by the root only.
+    let static_line = static_start.as_ref().map(|s| s.describe());
+    let say_static = |quiet: bool| {
+        if let (Some(line), false) = (&static_line, quiet) {
+            eprintln!("{line}");
+        }
+    };
     if let (Some(c), false) = (resume.filter(|_| static_start.is_none()), opts.quiet) {
         eprintln!(
             "restart    from step {} (t = {:.6e}) of {}: {} broken bonds",
@@ -957,6 +983,7 @@ fn run_setup<M: Model>(
             .collect(),
         layout: layout.describe(),
         first_step: resume.map_or(0, |c| c.step),
+        static_evaluations: static_start.as_ref().map_or(0, |s| s.evaluations),
         relaxation: relaxation.clone(),
         dt_critical: setup.dt_limit(),
         dt_critical_name: if setup.dt_measured.is_some() {
@@ -989,6 +1016,7 @@ fn run_setup<M: Model>(
             ..opts.clone()
         };
         prepare(&setup, scene, &quiet, &dir, &layout, "ranks", ranks)?;
+        say_static(quiet.quiet);
         let plans = crate::decomposition::cell_plans(&layout);
         let cube = parallel::build_cube(&setup, &layout, &plans, rank, Box::new(mpi));
         let p = plan(&layout);
@@ -1008,6 +1036,7 @@ fn run_setup<M: Model>(
     let layout = choose_layout(&setup, scene, opts, threads)?;
     one_cube(&layout)?;
     prepare(&setup, scene, opts, &dir, &layout, "threads", threads)?;
+    say_static(opts.quiet);
     let cubes = parallel::thread_cubes(&setup, &layout);
     let p = plan(&layout);
     let store = std::sync::Mutex::new(Some(frame_store(setup)));
@@ -1036,9 +1065,21 @@ fn resume_from<M: Model>(
     setup: &mut Setup<M>,
     from: &std::path::Path,
     scene_hash: u64,
+    start: f64,
 ) -> Result<Checkpoint, String> {
     let (path, c) = checkpoint::resolve(from)?;
     c.check_matches::<M>(&path, scene_hash, setup.sim.particles.len())?;
+    // Steps count from the run's start (`[time] static_until`, or 0): a checkpoint of a run
+    // that started elsewhere would end the restart at another time.
+    let began = c.time - c.step as f64 * c.dt;
+    if (began - start).abs() > 1e-6 * (c.time.abs() + c.dt) {
+        return Err(format!(
+            "checkpoint {}: its run started at t = {began:.6e} (step {} at t = {:.6e}), the deck now starts at t = {start:.6e} ([time] static_until); a restart continues the same run",
+            path.display(),
+            c.step,
+            c.time
+        ));
+    }
     let sim = &setup.sim;
     if c.dt != sim.dt || checkpoint::integrator(&c.integrator) != Some(sim.integrator) {
         return Err(format!(

@@ -326,6 +326,10 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     sim.loads = loads;
     sim.integrator = scene.time.integrator;
 
+    if let Some(until) = scene.time.static_until {
+        static_start_allowed::<M>(scene, until)?;
+    }
+
     // Time step: the bound, or the limit of central differences measured on the stiffest mode
     // (explicit runs only: relaxation's pseudo time has its own limit).
     let explicit = matches!(scene.solver, crate::deck::SolverSpec::Explicit);
@@ -370,9 +374,6 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         }
         None => scene.time.safety_factor * limit,
     };
-    if let Some(until) = scene.time.static_until {
-        static_start_allowed::<M>(scene, until)?;
-    }
     // A static start reaches `static_until` without steps; the steps follow it.
     let mut steps = match scene.time.length {
         RunLength::Steps(n) => n,

@@ -77,7 +77,7 @@ pub fn solve<M: Model>(
     let mut tangent = None;
     let r = cube
         .implicit_step(&mut tangent, TOLERANCE, MAX_ITERATIONS, 0)
-        .map_err(|e| format!("[time] static_until: {e}"))?;
+        .map_err(|e| format!("[time] static_until: {e} (or leave static_until out)"))?;
     if !r.converged {
         return Err(format!(
             "[time] static_until = {until:e}: the static solve did not converge (relative residual {:.2e} after {MAX_ITERATIONS} Newton iterations, {} bonds broken): the structure may not stand the loads at that time; start earlier",
@@ -86,9 +86,10 @@ pub fn solve<M: Model>(
         ));
     }
     let broken = cube.broken_count();
+    // No tangent when the start state is already in equilibrium (no load yet at `until`).
     let (method, nonzeros) = tangent
         .as_ref()
-        .map_or(("none", 0), |k| (k.method, k.nonzeros));
+        .map_or(("not needed", 0), |k| (k.method, k.nonzeros));
     cube.sim.dt = setup.sim.dt;
     cube.sim.step = 0;
     cube.sim.time = until;

@@ -167,6 +167,20 @@ fn a_restart_after_a_static_start_ends_bit_identical() {
     )
     .unwrap();
     assert_eq!((r.first_step, r.steps), (30, 60));
+    // The same checkpoint under a deck that starts elsewhere: refused.
+    let e = run_in(
+        &text.replace("\"0.5 ms\"", "\"0.4 ms\""),
+        &resumed,
+        RunOptions {
+            restart: Some(resumed.join("checkpoints/checkpoint_00000030.h5")),
+            ..layout(2, [2, 1, 1])
+        },
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("started at t = 5.0") && e.contains("static_until"),
+        "{e}"
+    );
     for file in ["final_positions.csv", "history.csv"] {
         let a = std::fs::read_to_string(straight.join(file)).unwrap();
         let b = std::fs::read_to_string(resumed.join(file)).unwrap();
@@ -217,6 +231,18 @@ fn what_a_static_start_cannot_do_is_refused_on_the_time_line() {
         "spacing = \"1 mm\"\nperiodic = [\"x\"]",
     ));
     assert!(e.contains("periodic"), "{e}");
+    // A stop at broken bonds the static start already passed: at a critical stretch of
+    // 1.2e-5 the static state at 5 N breaks 24 bonds at the load's and clamp's edges (and
+    // converges); the run would stop after one step.
+    let e = refused(
+        &text
+            .replace("critical_stretch = 0.05", "critical_stretch = 1.2e-5")
+            .replace("steps = 60", "steps = 60\nstop_at_broken_bonds = 1"),
+    );
+    assert!(
+        e.contains("broke 24 bonds") && e.contains("stop_at_broken_bonds = 1"),
+        "{e}"
+    );
     // A load the structure cannot stand: the static solve does not converge.
     let e = refused(&text.replace("critical_stretch = 0.05", "critical_stretch = 1e-7"));
     assert!(
