@@ -3,15 +3,13 @@
 //! a checkpoint, or stopped by SIGTERM, resumes; damaged or foreign checkpoints are refused.
 
 use pdq::checkpoint::Checkpoint;
-use pdq::deck;
-use pdq::decomposition::{Procs, Walls};
-use pdq::run::{run, RunOptions, Summary};
+use pdq::run::{RunOptions, Summary};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 mod common;
-use common::max_relative_difference;
+use common::{layout, max_relative_difference};
 
 const PULL: &str = include_str!("decks/notched_pull.toml");
 
@@ -36,24 +34,7 @@ fn out_dir(name: &str) -> PathBuf {
 }
 
 fn run_deck(text: &str, dir: &Path, opts: RunOptions) -> Result<Summary, String> {
-    let scene = deck::parse(text, "pull.toml", "pull").unwrap();
-    run(
-        &scene,
-        &RunOptions {
-            output: Some(dir.to_path_buf()),
-            quiet: true,
-            ..opts
-        },
-    )
-}
-
-fn layout(threads: usize, procs: [usize; 3]) -> RunOptions {
-    RunOptions {
-        threads: Some(threads),
-        procs: Some(Procs::Given(procs)),
-        walls: Some(Walls::Whole),
-        ..Default::default()
-    }
+    common::run_quietly(text, "pull.toml", dir, opts)
 }
 
 fn read(dir: &Path, file: &str) -> String {

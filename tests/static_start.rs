@@ -5,10 +5,8 @@
 
 mod common;
 
-use common::bar_deck;
-use pdq::deck;
-use pdq::decomposition::{Procs, Walls};
-use pdq::run::{run, RunOptions, Summary};
+use common::{bar_deck, layout};
+use pdq::run::{RunOptions, Summary};
 use std::path::{Path, PathBuf};
 
 /// The bar of tests/implicit.rs (10 N ramped over 1 ms), explicit, started statically at
@@ -35,24 +33,7 @@ fn out_dir(name: &str) -> PathBuf {
 }
 
 fn run_in(text: &str, dir: &Path, opts: RunOptions) -> Result<Summary, String> {
-    let scene = deck::parse(text, "bar.toml", "bar").map_err(|e| e.to_string())?;
-    run(
-        &scene,
-        &RunOptions {
-            output: Some(dir.to_path_buf()),
-            quiet: true,
-            ..opts
-        },
-    )
-}
-
-fn layout(threads: usize, procs: [usize; 3]) -> RunOptions {
-    RunOptions {
-        threads: Some(threads),
-        procs: Some(Procs::Given(procs)),
-        walls: Some(Walls::Whole),
-        ..Default::default()
-    }
+    common::run_quietly(text, "bar.toml", dir, opts)
 }
 
 /// The history's rows as (column → value) lookups.

@@ -97,3 +97,33 @@ final_state = true
 "#
     )
 }
+
+/// Runs deck `text` (named `name` in messages) quietly into `dir`, with `opts` otherwise.
+#[allow(dead_code)]
+pub fn run_quietly(
+    text: &str,
+    name: &str,
+    dir: &std::path::Path,
+    opts: pdq::run::RunOptions,
+) -> Result<pdq::run::Summary, String> {
+    let scene = pdq::deck::parse(text, name, "test").map_err(|e| e.to_string())?;
+    pdq::run::run(
+        &scene,
+        &pdq::run::RunOptions {
+            output: Some(dir.to_path_buf()),
+            quiet: true,
+            ..opts
+        },
+    )
+}
+
+/// `threads` procCubes laid out as `procs`, whole walls.
+#[allow(dead_code)]
+pub fn layout(threads: usize, procs: [usize; 3]) -> pdq::run::RunOptions {
+    pdq::run::RunOptions {
+        threads: Some(threads),
+        procs: Some(pdq::decomposition::Procs::Given(procs)),
+        walls: Some(pdq::decomposition::Walls::Whole),
+        ..Default::default()
+    }
+}
