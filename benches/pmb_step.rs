@@ -1,12 +1,12 @@
-//! `cargo bench`: the standard scene through `pdq::bench` (the same code as `pdq bench`).
+//! `cargo bench`: the standard scene through `pdq::lab::bench` (the same code as `pdq bench`).
 
 fn main() {
-    let opts = pdq::bench::BenchOptions {
+    let opts = pdq::lab::bench::BenchOptions {
         model: "pmb".into(),
         threads: vec![1],
         ranks: vec![],
-        walls: pdq::decomposition::Walls::Whole,
-        procs: pdq::decomposition::Procs::Auto,
+        walls: pdq::parallel::decomposition::Walls::Whole,
+        procs: pdq::parallel::decomposition::Procs::Auto,
         rounds: 1,
         yardstick: true,
         steps: 100,
@@ -16,7 +16,7 @@ fn main() {
         checkpoint: true,
         savings: false,
     };
-    match pdq::bench::run(&opts) {
+    match pdq::lab::bench::run(&opts) {
         Ok(s) => print!("{s}"),
         Err(e) => eprintln!("bench failed: {e}"),
     }

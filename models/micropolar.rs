@@ -23,8 +23,8 @@
 //! Solids break at s0 = √(5G0(1 − 2ν)/(3Eδ)) (axial energy only) or a given critical stretch;
 //! concrete (kind = "concrete") at its tensile and compressive stretches s_c < s < s_t.
 
-use crate::attributes::Attributes;
-use crate::lanes::{LaneForces, Real, F4, LANES};
+use crate::model::attributes::Attributes;
+use crate::model::lanes::{LaneForces, Real, F4, LANES};
 use crate::model::{check_options, BondGeom, MaterialKind, Model, ModelBuild, Side};
 use std::f64::consts::PI;
 

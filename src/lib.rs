@@ -1,44 +1,32 @@
 //! PDQ: a peridynamics engine for cracking of plain, reinforced and prestressed concrete.
 //!
-//! Data flows one way: [`deck`] (TOML) → [`geometry`] → [`particles`] and [`bonds`] →
-//! [`simulation`] (the step loop) → [`output`]. Models live in `models/`, one file each, and
-//! see nothing but the [`model::Model`] interface.
+//! The folders are the layers; each uses only the ones listed before it (`docs/architecture.md`
+//! draws the picture):
+//!
+//! - [`model`] — the interface a model file implements: declared attribute records, the
+//!   [`model::Model`] trait, vector lanes; [`models`] — one file per model (`models/`).
+//! - [`engine`] — one procCube's particles, bonds, cells, bond passes, boundary conditions,
+//!   integrators and the stable time step; it knows nothing of decks, files or other workers.
+//! - [`input`] — the deck (TOML → typed [`input::deck::Scene`]), units, geometry, bars, and
+//!   the built whole scene ([`input::setup`]).
+//! - [`parallel`] — the wall method: decomposition into procCubes, ghost messages on a
+//!   transport (threads or MPI), team reductions, shuffling, the procCube.
+//! - [`output`] — history, frames, checkpoints, progress, signals, plots.
+//! - [`solve`] — quasi-static and static solvers (ADR, the implicit Newton solve, the static
+//!   start).
+//! - [`driver`] — `pdq run` and `pdq check`: the step loop with its outputs.
+//! - [`lab`] — `pdq validate`, `pdq stress`, `pdq bench`.
 
-pub mod analysis;
-pub mod attributes;
-pub mod bars;
-pub mod bench;
-pub mod bonds;
-pub mod boundary;
-pub mod cells;
-pub mod checkpoint;
-pub mod comm;
-#[cfg(feature = "mpi")]
-pub mod comm_mpi;
-pub mod correction;
-pub mod deck;
-pub mod decomposition;
-pub mod forces;
-pub mod geometry;
-pub mod implicit;
-pub mod lanes;
 pub mod model;
 #[path = "../models/mod.rs"]
 pub mod models;
-pub mod output;
+
+pub mod engine;
+pub mod input;
 pub mod parallel;
-pub mod particles;
-pub mod plot;
-pub mod relaxation;
-pub mod run;
-pub mod setup;
-pub mod shuffle;
-pub mod signals;
-pub mod simulation;
-pub mod spectrum;
-pub mod static_start;
-pub mod stress;
-pub mod timing;
-pub mod units;
-pub mod validate;
-pub mod wall;
+
+pub mod output;
+pub mod solve;
+
+pub mod driver;
+pub mod lab;

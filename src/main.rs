@@ -1,7 +1,9 @@
 //! The `pdq` command line.
 
 use clap::{Parser, Subcommand};
-use pdq::{bench, deck, run};
+use pdq::driver::run;
+use pdq::input::deck;
+use pdq::lab::bench;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -35,10 +37,10 @@ enum Cmd {
         threads: Option<usize>,
         /// ProcCubes along x, y and z, as NXxNYxNZ (e.g. 2x2x1), or "auto".
         #[arg(long, value_parser = parse_procs)]
-        procs: Option<pdq::decomposition::Procs>,
+        procs: Option<pdq::parallel::decomposition::Procs>,
         /// Ghost messages: "whole" walls or "trimmed" to the cells each neighbour needs.
         #[arg(long, value_parser = parse_walls)]
-        walls: Option<pdq::decomposition::Walls>,
+        walls: Option<pdq::parallel::decomposition::Walls>,
         /// Resume from a checkpoint file, or from the newest readable checkpoint in a
         /// directory (an output directory or its checkpoints/).
         #[arg(long)]
@@ -130,10 +132,10 @@ enum Cmd {
         ranks: Vec<usize>,
         /// Ghost messages: whole walls or trimmed.
         #[arg(long, value_parser = parse_walls, default_value = "whole")]
-        walls: pdq::decomposition::Walls,
+        walls: pdq::parallel::decomposition::Walls,
         /// ProcCubes as NXxNYxNZ for every thread count (default: chosen per count).
         #[arg(long, value_parser = parse_procs)]
-        procs: Option<pdq::decomposition::Procs>,
+        procs: Option<pdq::parallel::decomposition::Procs>,
         /// Skip the generic-against-hand-written force pass comparison.
         #[arg(long)]
         no_yardstick: bool,
@@ -182,7 +184,7 @@ fn main() -> ExitCode {
         } => deck::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| {
-                pdq::signals::install()?;
+                pdq::output::signals::install()?;
                 run::run(
                     &scene,
                     &run::RunOptions {
@@ -190,8 +192,10 @@ fn main() -> ExitCode {
                         output,
                         quiet,
                         threads: threads.or(procs.as_ref().and_then(|p| match p {
-                            pdq::decomposition::Procs::Given(v) => Some(v.iter().product()),
-                            pdq::decomposition::Procs::Auto => None,
+                            pdq::parallel::decomposition::Procs::Given(v) => {
+                                Some(v.iter().product())
+                            }
+                            pdq::parallel::decomposition::Procs::Auto => None,
                         })),
                         procs,
                         walls,
@@ -212,14 +216,15 @@ fn main() -> ExitCode {
             m,
             solvers,
             ..
-        } => pdq::validate::sweep(&output, &models, &planes, &m, &solvers).map(|s| print!("{s}")),
+        } => pdq::lab::validate::sweep(&output, &models, &planes, &m, &solvers)
+            .map(|s| print!("{s}")),
         Cmd::Validate {
             output,
             threads,
             compare_adr: true,
             ramp_periods,
             ..
-        } => pdq::validate::compare_adr(&output, threads.unwrap_or_else(cores), ramp_periods)
+        } => pdq::lab::validate::compare_adr(&output, threads.unwrap_or_else(cores), ramp_periods)
             .map(|s| print!("{s}")),
         Cmd::Validate {
             quick: _,
@@ -230,12 +235,12 @@ fn main() -> ExitCode {
             compare_adr: false,
             solver,
             ..
-        } => pdq::validate::run_all(&pdq::validate::ValidateOptions {
+        } => pdq::lab::validate::run_all(&pdq::lab::validate::ValidateOptions {
             implicit: solver.map_or(!full, |s| s == "implicit"),
             level: if full {
-                pdq::validate::Level::Full
+                pdq::lab::validate::Level::Full
             } else {
-                pdq::validate::Level::Quick
+                pdq::lab::validate::Level::Quick
             },
             only: cases,
             output,
@@ -255,7 +260,7 @@ fn main() -> ExitCode {
             models,
             threads,
             output,
-        } => pdq::stress::run(&pdq::stress::StressOptions {
+        } => pdq::lab::stress::run(&pdq::lab::stress::StressOptions {
             quick,
             sections,
             models,
@@ -269,7 +274,7 @@ fn main() -> ExitCode {
                 None => Ok(()),
             }
         }),
-        Cmd::Info { file } => pdq::checkpoint::info(&file).map(|s| print!("{s}")),
+        Cmd::Info { file } => pdq::output::checkpoint::info(&file).map(|s| print!("{s}")),
         Cmd::Check { deck: path } => deck::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| run::check(&scene))
@@ -301,7 +306,7 @@ fn main() -> ExitCode {
                 ranks
             },
             walls,
-            procs: procs.unwrap_or(pdq::decomposition::Procs::Auto),
+            procs: procs.unwrap_or(pdq::parallel::decomposition::Procs::Auto),
             yardstick: !no_yardstick,
             steps,
             n,
@@ -314,7 +319,7 @@ fn main() -> ExitCode {
         .map(|s| print!("{s}")),
     };
     match result {
-        Ok(()) if interrupted => ExitCode::from(pdq::signals::EXIT_INTERRUPTED),
+        Ok(()) if interrupted => ExitCode::from(pdq::output::signals::EXIT_INTERRUPTED),
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
@@ -326,14 +331,14 @@ fn main() -> ExitCode {
 /// Whether this process is an MPI rank started by mpirun (always false without the feature).
 fn launched_by_mpirun() -> bool {
     #[cfg(feature = "mpi")]
-    return pdq::comm_mpi::launched_by_mpirun();
+    return pdq::parallel::comm_mpi::launched_by_mpirun();
     #[cfg(not(feature = "mpi"))]
     false
 }
 
-fn parse_procs(s: &str) -> Result<pdq::decomposition::Procs, String> {
+fn parse_procs(s: &str) -> Result<pdq::parallel::decomposition::Procs, String> {
     if s == "auto" {
-        return Ok(pdq::decomposition::Procs::Auto);
+        return Ok(pdq::parallel::decomposition::Procs::Auto);
     }
     let v: Vec<usize> = s
         .split('x')
@@ -341,23 +346,25 @@ fn parse_procs(s: &str) -> Result<pdq::decomposition::Procs, String> {
         .collect::<Result<_, _>>()
         .map_err(|_| format!("'{s}': give NXxNYxNZ, e.g. 2x2x1, or auto"))?;
     match v.as_slice() {
-        &[x, y, z] if x > 0 && y > 0 && z > 0 => Ok(pdq::decomposition::Procs::Given([x, y, z])),
+        &[x, y, z] if x > 0 && y > 0 && z > 0 => {
+            Ok(pdq::parallel::decomposition::Procs::Given([x, y, z]))
+        }
         _ => Err(format!(
             "'{s}': give three counts of at least 1, e.g. 2x2x1"
         )),
     }
 }
 
-fn parse_walls(s: &str) -> Result<pdq::decomposition::Walls, String> {
+fn parse_walls(s: &str) -> Result<pdq::parallel::decomposition::Walls, String> {
     match s {
-        "whole" => Ok(pdq::decomposition::Walls::Whole),
-        "trimmed" => Ok(pdq::decomposition::Walls::Trimmed),
+        "whole" => Ok(pdq::parallel::decomposition::Walls::Whole),
+        "trimmed" => Ok(pdq::parallel::decomposition::Walls::Trimmed),
         _ => Err(format!("'{s}': use whole or trimmed")),
     }
 }
 
 fn models_text() -> String {
-    let fields = |f: &[pdq::attributes::Field]| {
+    let fields = |f: &[pdq::model::attributes::Field]| {
         if f.is_empty() {
             "()".to_string()
         } else {

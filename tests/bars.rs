@@ -1,8 +1,8 @@
 //! Bars as one-dimensional members (src/bars.rs): a bar carries E·A·ε whatever its area and the
 //! lattice spacing, and a prestrained bar held at both ends pulls with E·A·ε_p.
 
-use pdq::deck;
-use pdq::run::{run, RunOptions};
+use pdq::driver::run::{run, RunOptions};
+use pdq::input::deck;
 
 const E: f64 = 29.0e6; // psi
 const LENGTH: f64 = 60.0; // in
@@ -95,7 +95,7 @@ fn solve(text: &str, columns: &[&str]) -> Vec<f64> {
         ..Default::default()
     };
     run(&scene, &options).unwrap();
-    let (header, rows) = pdq::validate::read_history(&dir).unwrap();
+    let (header, rows) = pdq::lab::validate::read_history(&dir).unwrap();
     let _ = std::fs::remove_dir_all(dir);
     let last = rows.last().unwrap();
     columns

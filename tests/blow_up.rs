@@ -1,8 +1,8 @@
 //! A run whose time step is forced above the stable bound stops with a message naming the
 //! step, the particle and the likely cause, and leaves a frame and a checkpoint of the state.
 
-use pdq::deck;
-use pdq::run::{run, RunOptions};
+use pdq::driver::run::{run, RunOptions};
+use pdq::input::deck;
 
 #[test]
 fn a_time_step_above_the_bound_stops_the_run_with_a_diagnosis_and_inspection_files() {
@@ -46,7 +46,7 @@ fn a_time_step_above_the_bound_stops_the_run_with_a_diagnosis_and_inspection_fil
         "{e}"
     );
     // The inspection checkpoint reads back.
-    let c = pdq::checkpoint::Checkpoint::read(&checkpoint).unwrap();
+    let c = pdq::output::checkpoint::Checkpoint::read(&checkpoint).unwrap();
     assert_eq!(c.step, step);
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -1,7 +1,7 @@
 //! Property test: for random particle clouds and horizons, the bond list holds every pair
 //! within the horizon exactly once.
 
-use pdq::bonds::BondList;
+use pdq::engine::bonds::BondList;
 use proptest::prelude::*;
 use std::collections::BTreeSet;
 

@@ -2,8 +2,8 @@
 //! stopped ends; a restart on another layout breaks the same bonds; a run killed while writing
 //! a checkpoint, or stopped by SIGTERM, resumes; damaged or foreign checkpoints are refused.
 
-use pdq::checkpoint::Checkpoint;
-use pdq::run::{RunOptions, Summary};
+use pdq::driver::run::{RunOptions, Summary};
+use pdq::output::checkpoint::Checkpoint;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -198,7 +198,7 @@ fn a_run_killed_while_writing_a_checkpoint_resumes_from_the_previous_one() {
     assert!(!out.join("checkpoints/checkpoint_00000300.h5").exists());
     // The half-written file is not a checkpoint; the previous one loads.
     assert!(Checkpoint::read(&tmp).is_err());
-    let (path, c) = pdq::checkpoint::resolve(&out).unwrap();
+    let (path, c) = pdq::output::checkpoint::resolve(&out).unwrap();
     assert_eq!(c.step, 200, "resumes from {}", path.display());
     pdq_run_ok(&deck, &out, &["--restart", &from]);
     let straight = work.join("straight");
@@ -239,11 +239,11 @@ fn sigterm_writes_a_checkpoint_and_the_run_resumes_from_it() {
     let stderr = String::from_utf8_lossy(&done.stderr);
     assert_eq!(
         done.status.code(),
-        Some(pdq::signals::EXIT_INTERRUPTED as i32),
+        Some(pdq::output::signals::EXIT_INTERRUPTED as i32),
         "{stderr}"
     );
     assert!(stderr.contains("--restart"), "says how to resume: {stderr}");
-    let (_, c) = pdq::checkpoint::resolve(&out).unwrap();
+    let (_, c) = pdq::output::checkpoint::resolve(&out).unwrap();
     assert!(c.step > 0);
     eprintln!(
         "SIGTERM: stopped at step {} with a checkpoint; {stderr}",
@@ -375,7 +375,7 @@ fn checkpoints_on_the_wall_clock_keep_the_newest() {
     );
     assert!(s.checkpoints.len() > 2, "{} written", s.checkpoints.len());
     assert_eq!(on_disk, 2);
-    let (_, c) = pdq::checkpoint::resolve(&dir).unwrap();
+    let (_, c) = pdq::output::checkpoint::resolve(&dir).unwrap();
     assert_eq!(c.step, 500, "the last step always gets one");
     let _ = std::fs::remove_dir_all(dir);
 }

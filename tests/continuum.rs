@@ -2,9 +2,9 @@
 //! strain, the virial stress at its centre particle (whose family and neighbours' families are
 //! whole), and the E and ν that stress implies, against the E and ν the deck gives.
 
-use pdq::analysis::{deform_affinely, virial_stress, young_poisson, CubicConstants};
+use pdq::engine::analysis::{deform_affinely, virial_stress, young_poisson, CubicConstants};
+use pdq::input::{deck, setup};
 use pdq::model::Model;
-use pdq::{deck, setup};
 
 /// A cube of `n`³ particles (n odd, so one sits at the centre) on a 1 mm lattice with horizon
 /// m·spacing.

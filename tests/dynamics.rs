@@ -1,9 +1,9 @@
 //! Conservation in free motion: energy in an elastic vibration for every model, angular
 //! momentum (with the particles' spins) for micropolar bodies spinning through large angles.
 
+use pdq::input::{deck, setup};
 use pdq::model::Model;
 use pdq::models::micropolar::Micropolar;
-use pdq::{deck, setup};
 
 fn block(model: &str, material: &str, options: &str) -> String {
     format!(

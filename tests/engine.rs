@@ -1,10 +1,10 @@
 //! Engine properties that must hold for any deck: conservation, bond history, breaking rule,
 //! time-step checks, and the bond search.
 
-use pdq::deck;
+use pdq::input::deck;
+use pdq::input::setup::{build_as, Setup};
 use pdq::models::concrete::Concrete;
 use pdq::models::pmb::Pmb;
-use pdq::setup::{build_as, Setup};
 
 /// A PMB block of `nx × ny × nz` particles at 1 mm spacing, horizon 3.015 mm, plus `extra` TOML.
 fn block(nx: usize, ny: usize, nz: usize, material: &str, extra: &str) -> String {

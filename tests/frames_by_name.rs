@@ -2,8 +2,8 @@
 //! values are the model's (rotations and moments for micropolar, temperature and heat for
 //! thermal, the dilatation for LPS).
 
-use pdq::deck;
-use pdq::run::{run, RunOptions};
+use pdq::driver::run::{run, RunOptions};
+use pdq::input::deck;
 
 mod common;
 

@@ -5,8 +5,8 @@
 mod common;
 
 use common::bar_deck;
-use pdq::deck;
-use pdq::run::{run, RunOptions, Summary};
+use pdq::driver::run::{run, RunOptions, Summary};
+use pdq::input::deck;
 
 /// Runs the bar; the summary, each load step's (load, reaction, tip displacement, residual)
 /// and the final positions.
@@ -24,7 +24,7 @@ fn solve(text: &str, threads: usize) -> Result<(Summary, Vec<[f64; 4]>, String),
             ..Default::default()
         },
     )?;
-    let (header, rows) = pdq::validate::read_history(&dir).unwrap();
+    let (header, rows) = pdq::lab::validate::read_history(&dir).unwrap();
     let col = |name: &str| header.iter().position(|c| c == name).unwrap();
     let picked = rows
         .iter()

@@ -1,7 +1,7 @@
 //! Every example deck in `inputs/` parses and builds; the quick one runs and breaks bonds.
 
-use pdq::deck;
-use pdq::run::{run, RunOptions};
+use pdq::driver::run::{run, RunOptions};
+use pdq::input::deck;
 use std::path::Path;
 
 #[test]
@@ -26,7 +26,7 @@ fn thesis_cantilever_deck_is_in_inch_pound_units() {
     // 145 lb/ft³ as pound-mass: 145 / 1728 / 386.09 lbf·s²/in⁴.
     assert!((c.density / (145.0 / 1728.0 / 386.09) - 1.0).abs() < 1e-12);
     assert_eq!(scene.horizon, 6.0);
-    let out = pdq::run::check(&scene).unwrap();
+    let out = pdq::driver::run::check(&scene).unwrap();
     assert!(out.contains("37500"), "{out}");
 }
 
@@ -67,7 +67,7 @@ fn quick_example_runs_and_cracks() {
 }
 
 /// Runs a variant of the example deck, quietly, into a fresh temporary directory.
-fn run_variant(text: &str, name: &str) -> (pdq::run::Summary, std::path::PathBuf) {
+fn run_variant(text: &str, name: &str) -> (pdq::driver::run::Summary, std::path::PathBuf) {
     let scene = deck::parse(text, &format!("pmb_block_{name}.toml"), name).unwrap();
     let dir = std::env::temp_dir().join(format!("pdq-inputs-{name}-{}", std::process::id()));
     let s = run(
@@ -102,7 +102,7 @@ fn a_run_stops_once_a_probe_has_moved_far_enough() {
         "stopped at step {}",
         s.steps
     );
-    let (header, rows) = pdq::validate::read_history(&dir).unwrap();
+    let (header, rows) = pdq::lab::validate::read_history(&dir).unwrap();
     let ux = header.iter().position(|c| c == "tip_ux").unwrap();
     let step = header.iter().position(|c| c == "step").unwrap();
     let (last, before) = (&rows[rows.len() - 1], &rows[rows.len() - 2]);
@@ -141,7 +141,7 @@ fn a_run_stops_once_enough_bonds_have_broken() {
         s.steps
     );
     // The last row read as the validation suite reads it.
-    let last = |column: &str| pdq::validate::last_of(&dir, column).unwrap();
+    let last = |column: &str| pdq::lab::validate::last_of(&dir, column).unwrap();
     assert_eq!(
         last("step") as u64,
         s.steps,

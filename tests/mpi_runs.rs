@@ -3,9 +3,9 @@
 //! `mpirun` on the PATH (`.ci/run` installs Open MPI).
 #![cfg(feature = "mpi")]
 
-use pdq::deck;
-use pdq::decomposition::{Procs, Walls};
-use pdq::run::{run, RunOptions};
+use pdq::driver::run::{run, RunOptions};
+use pdq::input::deck;
+use pdq::parallel::decomposition::{Procs, Walls};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -69,7 +69,7 @@ fn mpirun_deck(np: usize, deck: &Path, extra: &[&str], dir: &Path) {
 }
 
 /// The deck run on 4 threads as 2×2×1 procCubes, the reference of the rank runs.
-fn threads_reference(deck_path: &Path, dir: &Path) -> pdq::run::Summary {
+fn threads_reference(deck_path: &Path, dir: &Path) -> pdq::driver::run::Summary {
     let scene = deck::load(deck_path).unwrap();
     run(
         &scene,

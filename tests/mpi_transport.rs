@@ -3,8 +3,8 @@
 //! `mpirun -np 4 target/release/deps/mpi_transport-HASH`.
 #![cfg(feature = "mpi")]
 
-use pdq::comm::{Team, Transport};
-use pdq::comm_mpi::{launched_by_mpirun, Mpi};
+use pdq::parallel::comm::{Team, Transport};
+use pdq::parallel::comm_mpi::{launched_by_mpirun, Mpi};
 
 /// Bytes that say who sent them and when, `len` of them.
 fn pattern(sender: usize, round: u32, len: usize) -> Vec<u8> {

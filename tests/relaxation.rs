@@ -6,9 +6,9 @@
 mod common;
 
 use common::bar_deck;
-use pdq::deck;
-use pdq::decomposition::{Procs, Walls};
-use pdq::run::{run, RunOptions, Summary};
+use pdq::driver::run::{run, RunOptions, Summary};
+use pdq::input::deck;
+use pdq::parallel::decomposition::{Procs, Walls};
 
 fn relax(model: &str, threads: usize, procs: [usize; 3]) -> (Summary, Vec<Vec<f64>>) {
     let scene = deck::parse(&bar_deck(model, "adr"), "bar.toml", "bar").unwrap();
@@ -30,7 +30,7 @@ fn relax(model: &str, threads: usize, procs: [usize; 3]) -> (Summary, Vec<Vec<f6
         },
     )
     .unwrap();
-    let (header, rows) = pdq::validate::read_history(&dir).unwrap();
+    let (header, rows) = pdq::lab::validate::read_history(&dir).unwrap();
     let col = |name: &str| header.iter().position(|c| c == name).unwrap();
     let picked = rows
         .iter()

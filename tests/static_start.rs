@@ -6,7 +6,7 @@
 mod common;
 
 use common::{bar_deck, layout};
-use pdq::run::{RunOptions, Summary};
+use pdq::driver::run::{RunOptions, Summary};
 use std::path::{Path, PathBuf};
 
 /// The bar of tests/implicit.rs (10 N ramped over 1 ms), explicit, started statically at
@@ -38,7 +38,7 @@ fn run_in(text: &str, dir: &Path, opts: RunOptions) -> Result<Summary, String> {
 
 /// The history's rows as (column → value) lookups.
 fn rows(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    pdq::validate::read_history(dir).unwrap()
+    pdq::lab::validate::read_history(dir).unwrap()
 }
 
 fn at(header: &[String], row: &[f64], name: &str) -> f64 {

@@ -1,6 +1,6 @@
 //! The stability stress tests of `pdq stress` (docs/stability.md), at sizes a test can afford.
 
-use pdq::stress::{self, Failure, Lattice, StressOptions};
+use pdq::lab::stress::{self, Failure, Lattice, StressOptions};
 
 #[test]
 fn the_bound_is_below_the_measured_critical_step_on_every_lattice() {

@@ -2,8 +2,9 @@
 //! it as T = ½ erfc((x − x_s) / (2√(αt))), α = k/(ρc). The bar is periodic across its section,
 //! so every particle sees a whole family and the answer is one-dimensional.
 
-use pdq::decomposition::{Procs, Walls};
-use pdq::{deck, parallel, setup};
+use pdq::input::{deck, setup};
+use pdq::parallel;
+use pdq::parallel::decomposition::{Procs, Walls};
 
 /// erfc by Abramowitz & Stegun 7.1.26 (|error| < 1.5e-7), plenty for a 2 % check.
 fn erfc(x: f64) -> f64 {

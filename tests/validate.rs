@@ -1,7 +1,7 @@
 //! The validation runner: unknown cases are named, a measured value off its reference is
 //! reported as a failure with its error, and the report and plot files are written.
 
-use pdq::validate::{self, Case, Kind, Level, ValidateOptions};
+use pdq::lab::validate::{self, Case, Kind, Level, ValidateOptions};
 use std::path::Path;
 
 fn out(name: &str) -> std::path::PathBuf {
@@ -181,7 +181,7 @@ fn every_case_deck_parses() {
     for level in [Level::Quick, Level::Full] {
         for case in validate::cases(level) {
             let name = format!("{}.toml", case.name);
-            if let Err(e) = pdq::deck::parse(&case.deck, &name, &case.name) {
+            if let Err(e) = pdq::input::deck::parse(&case.deck, &name, &case.name) {
                 panic!("{:?} {}: {e}", level, case.name);
             }
             let reinforced = case.name.starts_with("concrete_rc_");

@@ -2,12 +2,12 @@
 //! results on every layout (threads here; `tests/mpi_runs.rs` does MPI), and clear refusals of
 //! layouts that cannot work.
 
-use pdq::deck;
-use pdq::decomposition::{Procs, Walls};
+use pdq::driver::run::{run, RunOptions, Summary};
+use pdq::input::deck;
+use pdq::input::setup::build_as;
 use pdq::models::pmb::Pmb;
 use pdq::parallel;
-use pdq::run::{run, RunOptions, Summary};
-use pdq::setup::build_as;
+use pdq::parallel::decomposition::{Procs, Walls};
 use proptest::prelude::*;
 
 mod common;

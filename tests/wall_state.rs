@@ -3,9 +3,10 @@
 //! dilatations and weighted volumes, gives the same dilatations, positions and cracks on every
 //! layout of procCubes, whole or trimmed walls.
 
-use pdq::decomposition::{Procs, Walls};
+use pdq::input::{deck, setup};
 use pdq::models::lps::Lps;
-use pdq::{deck, parallel, setup};
+use pdq::parallel;
+use pdq::parallel::decomposition::{Procs, Walls};
 
 mod common;
 use common::max_relative_difference;

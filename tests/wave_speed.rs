@@ -18,11 +18,12 @@
 //! in speed for a cross-section w spacings wide), and dispersion (wavelength 67δ in the free
 //! bars, 15δ in the periodic ones: −0.2 %).
 
-use pdq::attributes::Attributes;
-use pdq::decomposition::{Procs, Walls};
+use pdq::engine::simulation::Simulation;
+use pdq::input::{deck, setup};
+use pdq::model::attributes::Attributes;
 use pdq::model::Model;
-use pdq::simulation::Simulation;
-use pdq::{deck, parallel, setup};
+use pdq::parallel;
+use pdq::parallel::decomposition::{Procs, Walls};
 use std::f64::consts::PI;
 use std::time::Instant;
 

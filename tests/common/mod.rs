@@ -104,12 +104,12 @@ pub fn run_quietly(
     text: &str,
     name: &str,
     dir: &std::path::Path,
-    opts: pdq::run::RunOptions,
-) -> Result<pdq::run::Summary, String> {
-    let scene = pdq::deck::parse(text, name, "test").map_err(|e| e.to_string())?;
-    pdq::run::run(
+    opts: pdq::driver::run::RunOptions,
+) -> Result<pdq::driver::run::Summary, String> {
+    let scene = pdq::input::deck::parse(text, name, "test").map_err(|e| e.to_string())?;
+    pdq::driver::run::run(
         &scene,
-        &pdq::run::RunOptions {
+        &pdq::driver::run::RunOptions {
             output: Some(dir.to_path_buf()),
             quiet: true,
             ..opts
@@ -119,11 +119,11 @@ pub fn run_quietly(
 
 /// `threads` procCubes laid out as `procs`, whole walls.
 #[allow(dead_code)]
-pub fn layout(threads: usize, procs: [usize; 3]) -> pdq::run::RunOptions {
-    pdq::run::RunOptions {
+pub fn layout(threads: usize, procs: [usize; 3]) -> pdq::driver::run::RunOptions {
+    pdq::driver::run::RunOptions {
         threads: Some(threads),
-        procs: Some(pdq::decomposition::Procs::Given(procs)),
-        walls: Some(pdq::decomposition::Walls::Whole),
+        procs: Some(pdq::parallel::decomposition::Procs::Given(procs)),
+        walls: Some(pdq::parallel::decomposition::Walls::Whole),
         ..Default::default()
     }
 }

@@ -1,0 +1,15 @@
+//! One procCube's physics: the particle store, the bond list, cells, the bond passes, boundary
+//! conditions and loads, the integrators and the stable time step. Nothing here reads a deck,
+//! writes a file or knows how many workers there are: where ghost data must move, the step
+//! calls an [`simulation::Exchange`] it is handed.
+
+pub mod analysis;
+pub mod bonds;
+pub mod boundary;
+pub mod cells;
+pub mod correction;
+pub mod forces;
+pub mod particles;
+pub mod simulation;
+pub mod spectrum;
+pub mod timing;

@@ -1,0 +1,298 @@
+//! One procCube's time stepping: particles and bonds, forces, loads and constraints, integration.
+//!
+//! ```text
+//! first-order DOFs (Euler) → kick → constrain → drift → exchange (forward)
+//!      → [state pass → reverse-sum → finish] → pair pass → reverse force sum
+//!      → loads, constraints → kick → constrain
+//! ```
+//! The exchange points are where the wall method's ghost messages go; a single procCube with
+//! no periodic axis has no ghosts and [`Local`] does nothing there.
+
+use crate::engine::bonds::BondList;
+use crate::engine::boundary::{Constraint, Load};
+use crate::engine::forces;
+use crate::engine::particles::Particles;
+use crate::engine::timing::{Phase, Timing};
+use crate::model::attributes::Attributes;
+use crate::model::{second_order, Model};
+use crate::parallel::comm::{Solo, Transport};
+use crate::parallel::wall::WallExchange;
+use std::time::Instant;
+
+/// Time integration of the generalized degrees of freedom.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// Velocity Verlet (half kick, drift, forces, half kick): second order, symplectic.
+    VelocityVerlet,
+    /// The thesis's scheme (appendix A.3.2): v += Δt·F/m, then x += Δt·v.
+    SemiImplicitEuler,
+}
+
+impl Integrator {
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::VelocityVerlet => "velocity-verlet",
+            Integrator::SemiImplicitEuler => "semi-implicit-euler",
+        }
+    }
+}
+
+/// Moves ghost data between procCubes at the points of the step where the wall method needs it.
+pub trait Exchange<M: Model> {
+    /// Alterable attributes of owned particles to their ghost copies.
+    fn forward(&mut self, _p: &mut Particles<M>) {}
+    /// Partial state sums on ghosts back to their owners (summed on arrival).
+    fn reverse_state(&mut self, _p: &mut Particles<M>) {}
+    /// Finished state of owned particles to their ghost copies.
+    fn forward_state(&mut self, _p: &mut Particles<M>) {}
+    /// Generalized forces on ghosts back to their owners (summed on arrival).
+    fn reverse_force(&mut self, _p: &mut Particles<M>) {}
+    /// The byte mover underneath, for reductions and gathers at output time.
+    fn transport(&mut self) -> &mut dyn Transport;
+    /// The wall-method exchange, if this is one.
+    fn wall(&mut self) -> Option<&mut WallExchange> {
+        None
+    }
+}
+
+/// One procCube, no ghosts: nothing to move.
+#[derive(Default)]
+pub struct Local(Solo);
+impl<M: Model> Exchange<M> for Local {
+    fn transport(&mut self) -> &mut dyn Transport {
+        &mut self.0
+    }
+}
+
+pub struct Simulation<M: Model> {
+    pub model: M,
+    pub particles: Particles<M>,
+    pub bonds: BondList<M::Bond>,
+    pub constraints: Vec<Constraint>,
+    pub loads: Vec<Load>,
+    pub integrator: Integrator,
+    pub dt: f64,
+    pub time: f64,
+    pub step: u64,
+    pub timing: Timing,
+    pub exchange: Box<dyn Exchange<M> + Send>,
+}
+
+impl<M: Model> Simulation<M> {
+    pub fn new(model: M, particles: Particles<M>, bonds: BondList<M::Bond>, dt: f64) -> Self {
+        Simulation {
+            model,
+            particles,
+            bonds,
+            constraints: Vec::new(),
+            loads: Vec::new(),
+            integrator: Integrator::VelocityVerlet,
+            dt,
+            time: 0.0,
+            step: 0,
+            timing: Timing::default(),
+            exchange: Box::new(Local::default()),
+        }
+    }
+
+    /// Whether each second-order DOF of the owned particles (particle-major) is free: held by
+    /// no boundary condition (fixed or driven).
+    pub fn free_dofs(&self) -> Vec<bool> {
+        let n2 = second_order::<M>();
+        let mut free = vec![true; self.particles.n_owned * n2];
+        for c in &self.constraints {
+            for &i in &c.particles {
+                for &k in c.dofs.iter().filter(|&&k| k < n2) {
+                    free[i as usize * n2 + k] = false;
+                }
+            }
+        }
+        free
+    }
+
+    /// Forces at the current state, loads and constraint reactions included. Returns the
+    /// number of bonds that broke.
+    pub fn compute_forces(&mut self) -> usize {
+        let p = &mut self.particles;
+        let mut t = Instant::now();
+        self.exchange.forward(p);
+        t = self.timing.lap(Phase::Communication, t);
+        if <M::State as Attributes>::LEN > 0 {
+            forces::state_pass(&self.model, p, &mut self.bonds);
+            self.exchange.reverse_state(p);
+            forces::finish_state(&self.model, p);
+            self.exchange.forward_state(p);
+            t = self.timing.lap(Phase::State, t);
+        }
+        let broken = forces::pair_pass(&self.model, p, &mut self.bonds);
+        t = self.timing.lap(Phase::Forces, t);
+        self.exchange.reverse_force(p);
+        t = self.timing.lap(Phase::Communication, t);
+        for load in &self.loads {
+            load.apply(p, self.time);
+        }
+        for c in &mut self.constraints {
+            c.take_forces(p);
+        }
+        self.timing.lap(Phase::Boundary, t);
+        broken
+    }
+
+    /// v += h·F/m on every owned second-order DOF.
+    fn kick(&mut self, h: f64) {
+        let n = second_order::<M>();
+        let p = &mut self.particles;
+        for i in 0..p.n_owned {
+            let f = p.force[i].as_slice();
+            let inv = p.inv_inertia[i].as_slice();
+            let a = p.alter[i].as_mut_slice();
+            for k in 0..n {
+                a[n + k] += h * f[k] * inv[k];
+            }
+        }
+    }
+
+    /// q += h·F/C on every owned first-order DOF (forward Euler with the rates of the last
+    /// force evaluation). Compiled away for models without first-order DOFs.
+    fn advance_first_order(&mut self, h: f64) {
+        if M::FIRST_ORDER == 0 {
+            return;
+        }
+        let n = second_order::<M>();
+        let p = &mut self.particles;
+        for i in 0..p.n_owned {
+            let f = p.force[i].as_slice();
+            let inv = p.inv_inertia[i].as_slice();
+            let a = p.alter[i].as_mut_slice();
+            for k in 0..M::FIRST_ORDER {
+                a[2 * n + k] += h * f[n + k] * inv[n + k];
+            }
+        }
+    }
+
+    /// q += h·v on every owned second-order DOF (the model composes finite rotations).
+    fn drift(&mut self, h: f64) {
+        let p = &mut self.particles;
+        for a in &mut p.alter[..p.n_owned] {
+            self.model.drift(a, h);
+        }
+    }
+
+    /// Advances one time step; returns the number of bonds that broke in it.
+    pub fn advance(&mut self) -> usize {
+        let (dt, t0) = (self.dt, self.time);
+        let start = Instant::now();
+        self.advance_first_order(dt);
+        match self.integrator {
+            Integrator::VelocityVerlet => self.kick(0.5 * dt),
+            Integrator::SemiImplicitEuler => self.kick(dt),
+        }
+        for c in &self.constraints {
+            c.set_drift_velocity(&mut self.particles, t0, dt);
+        }
+        self.drift(dt);
+        self.time = t0 + dt;
+        self.step += 1;
+        self.timing.lap(Phase::Integration, start);
+        let broken = self.compute_forces();
+        let start = Instant::now();
+        if self.integrator == Integrator::VelocityVerlet {
+            self.kick(0.5 * dt);
+        }
+        for c in &self.constraints {
+            c.set_velocity(&mut self.particles, self.time, dt);
+        }
+        self.timing.lap(Phase::Integration, start);
+        broken
+    }
+
+    pub fn strain_energy(&self) -> f64 {
+        forces::strain_energy(&self.model, &self.particles, &self.bonds)
+    }
+
+    pub fn kinetic_energy(&self) -> f64 {
+        self.particles.kinetic_energy()
+    }
+}
+
+/// Σ_j V_j C_ij for each particle and DOF, C_ij the bond stiffness of [`Model::bond_stiffness`]:
+/// V_i times it bounds the particle's diagonal stiffness (THEORY.md §4, §5).
+pub fn stiffness_sums<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &BondList<M::Bond>,
+) -> Vec<M::Force> {
+    stiffness_sums_of(model, p, bonds, |law, _, _, geom| {
+        model.bond_stiffness(law, geom)
+    })
+}
+
+/// Σ_j V_j C_ij with C_ij from `stiffness(law, i, j, geom)`.
+pub fn stiffness_sums_of<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &BondList<M::Bond>,
+    stiffness: impl Fn(&M::Law, usize, usize, &crate::model::BondGeom) -> M::Force,
+) -> Vec<M::Force> {
+    let mut sum = vec![M::Force::default(); p.len()];
+    for (i, j, b) in bonds.iter() {
+        let law = model.law(p.material[i], p.material[j]);
+        let c = stiffness(&law, i, j, &bonds.geom[b]);
+        let c = c.as_slice();
+        // β ≤ 1 (partial volume) is left out, which errs on the safe side; a calibrated bar bond
+        // (bars.rs) or a surface-corrected one can be stiffer than its law, and counts.
+        let beta = bonds.geom[b].beta.max(1.0);
+        for (k, v) in sum[i].as_mut_slice().iter_mut().enumerate() {
+            *v += p.volume[j] * c[k] * beta;
+        }
+        for (k, v) in sum[j].as_mut_slice().iter_mut().enumerate() {
+            *v += p.volume[i] * c[k] * beta;
+        }
+    }
+    sum
+}
+
+/// The stable time step and the particle that sets it (THEORY.md §4): for each second-order
+/// DOF the Silling–Askari bound √(2m / (V_i Σ_j V_j C_ij)), for each first-order DOF the
+/// forward-Euler bound C / (V_i Σ_j V_j K_ij) (Gershgorin: twice the diagonal bounds the
+/// largest eigenvalue). Infinite if no particle has a bond.
+pub fn stable_time_step<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &BondList<M::Bond>,
+) -> (f64, usize) {
+    let [second, first] = stable_time_steps(model, p, bonds);
+    if first.0 < second.0 {
+        first
+    } else {
+        second
+    }
+}
+
+/// [`stable_time_step`] of the second-order and of the first-order DOFs apart.
+pub fn stable_time_steps<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &BondList<M::Bond>,
+) -> [(f64, usize); 2] {
+    let sum = stiffness_sums(model, p, bonds);
+    let n2 = second_order::<M>();
+    let mut best = [(f64::INFINITY, 0); 2];
+    for (i, s) in sum.iter().enumerate().take(p.n_owned) {
+        let inv = p.inv_inertia[i].as_slice();
+        for (k, &s) in s.as_slice().iter().enumerate() {
+            if s > 0.0 {
+                let inertia = 1.0 / (inv[k] * p.volume[i] * s);
+                let (dt, order) = if k < n2 {
+                    ((2.0 * inertia).sqrt(), 0)
+                } else {
+                    (inertia, 1)
+                };
+                if dt < best[order].0 {
+                    best[order] = (dt, i);
+                }
+            }
+        }
+    }
+    best
+}

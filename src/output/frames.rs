@@ -1,0 +1,256 @@
+//! Particle frames for ParaView.
+//!
+//! Frames are HDF5 files (one per frame: the points, then one dataset per array, every
+//! attribute the model declares under its own name) tied into a time series by an XDMF file,
+//! `frames.xdmf`, which ParaView opens directly (choose the "Xdmf3 Reader" if it asks).
+
+use crate::engine::particles::Particles;
+use crate::model::attributes::Attributes;
+use crate::model::Model;
+use crate::output::write_atomically;
+use std::path::{Path, PathBuf};
+
+/// A time series of HDF5 frames and the XDMF file that lists them.
+pub struct Frames {
+    dir: PathBuf,
+    /// Step, time, particle count and arrays of each frame written, for the XDMF index.
+    entries: Vec<FrameEntry>,
+}
+
+struct FrameEntry {
+    step: u64,
+    time: f64,
+    n: usize,
+    arrays: Vec<(String, usize, &'static str)>,
+}
+
+/// One array of a frame: name, components per particle, values (particle-major).
+enum Array {
+    F64(String, usize, Vec<f64>),
+    I32(String, Vec<i32>),
+}
+
+impl Array {
+    fn name(&self) -> &str {
+        match self {
+            Array::F64(n, _, _) | Array::I32(n, _) => n,
+        }
+    }
+}
+
+/// One array per field of `records`, named as the model declares it.
+fn push_fields<A: Attributes>(arrays: &mut Vec<Array>, records: &[A]) {
+    let mut offset = 0;
+    for f in A::FIELDS {
+        let o = offset;
+        arrays.push(Array::F64(
+            f.name.to_string(),
+            f.len,
+            records
+                .iter()
+                .flat_map(|r| r.as_slice()[o..o + f.len].to_vec())
+                .collect(),
+        ));
+        offset += f.len;
+    }
+}
+
+/// The file name of the frame at `step`, relative to the output directory.
+pub fn frame_name(step: u64) -> String {
+    format!("frames/frame_{step:08}.h5")
+}
+
+impl Frames {
+    pub fn new(dir: &Path) -> std::io::Result<Frames> {
+        std::fs::create_dir_all(dir.join("frames"))?;
+        Ok(Frames {
+            dir: dir.to_path_buf(),
+            entries: Vec::new(),
+        })
+    }
+
+    /// Continues the time series of a restarted run: the frames on the schedule (multiples of
+    /// `every`) up to `step` that are on disk are listed again; later ones (written after the
+    /// checkpoint the run resumes from) are left out and overwritten when reached.
+    pub fn resume(dir: &Path, step: u64, every: u64) -> Result<Frames, String> {
+        let mut frames = Frames::new(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let mut steps: Vec<u64> = std::fs::read_dir(dir.join("frames"))
+            .map_err(|e| format!("{}: {e}", dir.display()))?
+            .filter_map(|e| {
+                let name = e.ok()?.file_name().into_string().ok()?;
+                name.strip_prefix("frame_")?
+                    .strip_suffix(".h5")?
+                    .parse()
+                    .ok()
+            })
+            .filter(|&s: &u64| s <= step && s.is_multiple_of(every.max(1)))
+            .collect();
+        steps.sort_unstable();
+        for s in steps {
+            let path = dir.join(frame_name(s));
+            // A frame that cannot be read is left out of the series, not fatal.
+            if let Ok(entry) = read_entry(&path, s) {
+                frames.entries.push(entry);
+            }
+        }
+        Ok(frames)
+    }
+
+    /// Writes the owned particles at `step`, then rewrites the XDMF index.
+    pub fn write<M: Model>(
+        &mut self,
+        step: u64,
+        time: f64,
+        p: &Particles<M>,
+        damage: &[f64],
+        broken_bonds: usize,
+    ) -> std::io::Result<PathBuf> {
+        let n = p.n_owned;
+        let name = frame_name(step);
+        let path = self.dir.join(&name);
+        let mut arrays = vec![
+            Array::I32("id".into(), p.gid[..n].iter().map(|&g| g as i32).collect()),
+            Array::I32(
+                "material".into(),
+                p.material[..n].iter().map(|&m| m as i32).collect(),
+            ),
+            Array::F64("damage".into(), 1, damage[..n].to_vec()),
+            Array::F64(
+                "displacement".into(),
+                3,
+                (0..n).flat_map(|i| p.displacement(i)).collect(),
+            ),
+            Array::F64("volume".into(), 1, p.volume[..n].to_vec()),
+        ];
+        // Every declared per-particle attribute, by its declared name.
+        push_fields(&mut arrays, &p.alter[..n]);
+        push_fields(&mut arrays, &p.fixed[..n]);
+        push_fields(&mut arrays, &p.state[..n]);
+        push_fields(&mut arrays, &p.force[..n]);
+        let mut b = hdf5_pure::FileBuilder::new();
+        b.set_attr("step", hdf5_pure::AttrValue::U64(step));
+        b.set_attr("time", hdf5_pure::AttrValue::F64(time));
+        b.set_attr("model", hdf5_pure::AttrValue::String(M::NAME.into()));
+        b.set_attr(
+            "broken_bonds",
+            hdf5_pure::AttrValue::U64(broken_bonds as u64),
+        );
+        let points: Vec<f64> = (0..n).flat_map(|i| p.pos(i)).collect();
+        b.create_dataset("points")
+            .with_f64_data(&points)
+            .with_shape(&[n as u64, 3]);
+        // Polyvertex connectivity: ParaView does without it, other XDMF readers need it.
+        let cells: Vec<i32> = (0..n as i32).collect();
+        b.create_dataset("cells").with_i32_data(&cells);
+        let mut listed = Vec::new();
+        for a in &arrays {
+            match a {
+                Array::F64(name, comps, v) => {
+                    let d = b.create_dataset(name).with_f64_data(v);
+                    if *comps > 1 {
+                        d.with_shape(&[n as u64, *comps as u64]);
+                    }
+                    listed.push((name.clone(), *comps, "Float\" Precision=\"8"));
+                }
+                Array::I32(name, v) => {
+                    b.create_dataset(name).with_i32_data(v);
+                    listed.push((name.clone(), 1, "Int\" Precision=\"4"));
+                }
+            }
+        }
+        debug_assert!(arrays.iter().all(|a| !a.name().is_empty()));
+        write_atomically(&path, b, None)?;
+        self.entries.retain(|e| e.step < step);
+        self.entries.push(FrameEntry {
+            step,
+            time,
+            n,
+            arrays: listed,
+        });
+        self.write_index()?;
+        Ok(path)
+    }
+
+    /// `frames.xdmf`: a temporal collection of point clouds, one HDF5 file per frame.
+    fn write_index(&self) -> std::io::Result<()> {
+        let mut x = String::new();
+        x.push_str("<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n<Domain>\n");
+        x.push_str("<Grid Name=\"frames\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+        for e in &self.entries {
+            let file = frame_name(e.step);
+            let n = e.n;
+            let item = |name: &str, dims: &str, ty: &str| {
+                format!(
+                    "<DataItem Dimensions=\"{dims}\" NumberType=\"{ty}\" Format=\"HDF\">{file}:/{name}</DataItem>"
+                )
+            };
+            x.push_str(&format!(
+                "<Grid Name=\"step_{}\" GridType=\"Uniform\">\n<Time Value=\"{:.17e}\"/>\n",
+                e.step, e.time
+            ));
+            x.push_str(&format!(
+                "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{n}\" NodesPerElement=\"1\">{}</Topology>\n",
+                item("cells", &format!("{n}"), "Int\" Precision=\"4")
+            ));
+            x.push_str(&format!(
+                "<Geometry GeometryType=\"XYZ\">{}</Geometry>\n",
+                item("points", &format!("{n} 3"), "Float\" Precision=\"8")
+            ));
+            for (name, comps, ty) in &e.arrays {
+                let (kind, dims) = match comps {
+                    1 => ("Scalar", format!("{n}")),
+                    3 => ("Vector", format!("{n} 3")),
+                    9 => ("Tensor", format!("{n} 9")),
+                    c => ("Matrix", format!("{n} {c}")),
+                };
+                x.push_str(&format!(
+                    "<Attribute Name=\"{name}\" AttributeType=\"{kind}\" Center=\"Node\">{}</Attribute>\n",
+                    item(name, &dims, ty)
+                ));
+            }
+            x.push_str("</Grid>\n");
+        }
+        x.push_str("</Grid>\n</Domain>\n</Xdmf>\n");
+        let tmp = self.dir.join("frames.xdmf.tmp");
+        std::fs::write(&tmp, x)?;
+        std::fs::rename(tmp, self.dir.join("frames.xdmf"))
+    }
+}
+
+/// The XDMF entry of a frame on disk (a restarted run lists the frames it keeps).
+fn read_entry(path: &Path, step: u64) -> Result<FrameEntry, String> {
+    let f = hdf5_pure::File::open(path).map_err(|e| e.to_string())?;
+    let attrs = f.root().attrs().map_err(|e| e.to_string())?;
+    let time = match attrs.get("time") {
+        Some(hdf5_pure::AttrValue::F64(t)) => *t,
+        _ => return Err("no time".into()),
+    };
+    let n = f
+        .dataset("points")
+        .and_then(|d| d.shape())
+        .map_err(|e| e.to_string())?
+        .first()
+        .copied()
+        .unwrap_or(0) as usize;
+    let mut arrays = Vec::new();
+    for name in f.root().datasets().map_err(|e| e.to_string())? {
+        if name == "points" || name == "cells" {
+            continue;
+        }
+        let d = f.dataset(&name).map_err(|e| e.to_string())?;
+        let shape = d.shape().map_err(|e| e.to_string())?;
+        let comps = shape.get(1).copied().unwrap_or(1) as usize;
+        let ty = if name == "id" || name == "material" {
+            "Int\" Precision=\"4"
+        } else {
+            "Float\" Precision=\"8"
+        };
+        arrays.push((name, comps, ty));
+    }
+    Ok(FrameEntry {
+        step,
+        time,
+        n,
+        arrays,
+    })
+}

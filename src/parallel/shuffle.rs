@@ -1,0 +1,335 @@
+//! Particle shuffling (thesis 3.11): when particles have left their procCubes, ownership is
+//! redrawn from current positions and every particle moves to its new owner with all its
+//! attributes, its bonds' history attached.
+//!
+//! Bond families never change in peridynamics, so a scene whose particles stay near their
+//! reference cells never needs this (ghost lists are drawn from reference cells and stay
+//! correct under any motion); it pays off when matter travels far, where it keeps each
+//! procCube's particles and their partners together and the load balanced. A shuffle is a
+//! collective step: every worker sends its particles and bonds to all, and each rebuilds its
+//! procCube from the whole set with the same code that built it at the start. That costs one
+//! all-to-all exchange of the scene, so decks ask for it every N steps (`shuffle_every`).
+//!
+//! Intact bonds are then evaluated from the cells of their ends' current positions, which must
+//! be neighbours: cells carry a skin over the horizon for this. Broken bonds carry no force
+//! ever again, so a shuffle drops them from the bond lists and keeps them as counts (damage)
+//! and as id pairs (the broken-bond output).
+
+use crate::engine::bonds::BondList;
+use crate::engine::cells::HALF_SHELL;
+use crate::model::attributes::Attributes;
+use crate::model::{BondGeom, Model};
+use crate::parallel::comm::{f64s, Team};
+use crate::parallel::decomposition::{cell_plans, cube_plan, Layout};
+use crate::parallel::{local_particles, Cube};
+use std::collections::HashMap;
+
+/// Fixed part of a particle record: gid, x0 (3), volume, material, initial bonds, lost bonds.
+const PARTICLE_HEAD: usize = 8;
+/// Fixed part of a bond record: gid i, gid j, length, beta, broken.
+const BOND_HEAD: usize = 5;
+
+impl<M: Model> Cube<M> {
+    /// Whether some owned particle now lies more than a quarter cell inside another procCube's
+    /// cells. The quarter cell is hysteresis: ownership and ghost lists depend only on the
+    /// cells, never on positions, so a particle may sit just across its procCube's face without
+    /// harm, and one vibrating on a face would otherwise make every check shuffle the scene.
+    fn someone_left(&mut self) -> bool {
+        const MARGIN: f64 = 0.25;
+        let p = &self.sim.particles;
+        let d = &self.layout.domain;
+        let g = &d.grid;
+        let (lo, hi) = (self.plan.cells.lo, self.plan.cells.hi);
+        let mut left = false;
+        'particles: for i in 0..p.n_owned {
+            let x = wrap(p.pos(i), d).0;
+            for a in 0..3 {
+                // Matter beyond the grid counts in the edge cells (as `CellGrid::coords`).
+                let f = (x[a] - g.origin[a]) / g.size[a];
+                let below = lo[a] > 0 && f < lo[a] as f64 - MARGIN;
+                let above = (hi[a] as usize) < g.dims[a] && f >= hi[a] as f64 + MARGIN;
+                if below || above {
+                    left = true;
+                    break 'particles;
+                }
+            }
+        }
+        Team::new(self.sim.exchange.transport()).max(if left { 1.0 } else { 0.0 }) > 0.0
+    }
+
+    /// Redraws ownership from current positions if any particle left its procCube. Every worker
+    /// must call it at the same step; returns whether particles moved.
+    pub fn shuffle(&mut self) -> Result<bool, String> {
+        if !self.someone_left() {
+            return Ok(false);
+        }
+        let la = <M::Alter as Attributes>::LEN;
+        let lf = <M::Force as Attributes>::LEN;
+        let lx = <M::Fixed as Attributes>::LEN;
+        let lh = <M::Bond as Attributes>::LEN;
+        let p = &self.sim.particles;
+        let b = &self.sim.bonds;
+        let mut mine: Vec<f64> = vec![p.n_owned as f64, b.len() as f64, self.dropped.len() as f64];
+        for i in 0..p.n_owned {
+            mine.push(p.gid[i] as f64);
+            mine.extend_from_slice(&p.x0[i]);
+            mine.push(p.volume[i]);
+            mine.push(p.material[i] as f64);
+            mine.push(b.initial[i] as f64);
+            mine.push(self.lost[i] as f64);
+            mine.extend_from_slice(p.alter[i].as_slice());
+            mine.extend_from_slice(p.force[i].as_slice());
+            mine.extend_from_slice(p.fixed[i].as_slice());
+        }
+        for (i, j, k) in b.iter() {
+            mine.extend_from_slice(&[
+                p.gid[i] as f64,
+                p.gid[j] as f64,
+                b.geom[k].length,
+                b.geom[k].beta,
+                if b.broken[k] { 1.0 } else { 0.0 },
+            ]);
+            mine.extend_from_slice(b.history[k].as_slice());
+        }
+        for &(a, c) in &self.dropped {
+            mine.extend_from_slice(&[a as f64, c as f64]);
+        }
+        // Everyone gets everything: gather on the root, then the root's concatenation to all.
+        let mut team = Team::new(self.sim.exchange.transport());
+        let mut all: Vec<u8> = team
+            .gather(bytemuck::cast_slice(&mine))
+            .map(|parts| parts.concat())
+            .unwrap_or_default();
+        team.broadcast(&mut all);
+        let all = f64s(&all);
+
+        // The whole scene by global id.
+        let n = self.global_particles;
+        let mut x0 = vec![[0.0; 3]; n];
+        let mut volume = vec![0.0; n];
+        let mut material = vec![0u16; n];
+        let mut initial = vec![0u32; n];
+        let mut lost = vec![0u32; n];
+        let mut alter = vec![M::Alter::default(); n];
+        let mut force = vec![M::Force::default(); n];
+        let mut fixed = vec![M::Fixed::default(); n];
+        let mut bonds: Vec<(u32, u32, BondGeom, M::Bond)> = Vec::new();
+        let mut dropped: Vec<(u32, u32)> = Vec::new();
+        let mut at = 0;
+        while at < all.len() {
+            let (np, nb, nd) = (all[at] as usize, all[at + 1] as usize, all[at + 2] as usize);
+            at += 3;
+            for _ in 0..np {
+                let r = &all[at..at + PARTICLE_HEAD + la + lf + lx];
+                let g = r[0] as usize;
+                x0[g] = [r[1], r[2], r[3]];
+                volume[g] = r[4];
+                material[g] = r[5] as u16;
+                initial[g] = r[6] as u32;
+                // Broken bonds from records read earlier may already have counted here.
+                lost[g] += r[7] as u32;
+                alter[g]
+                    .as_mut_slice()
+                    .copy_from_slice(&r[PARTICLE_HEAD..PARTICLE_HEAD + la]);
+                force[g]
+                    .as_mut_slice()
+                    .copy_from_slice(&r[PARTICLE_HEAD + la..PARTICLE_HEAD + la + lf]);
+                // Fixed data travels whole: bond sums (LPS weighted volume) are not redone.
+                fixed[g]
+                    .as_mut_slice()
+                    .copy_from_slice(&r[PARTICLE_HEAD + la + lf..]);
+                at += PARTICLE_HEAD + la + lf + lx;
+            }
+            for _ in 0..nb {
+                let r = &all[at..at + BOND_HEAD + lh];
+                let (gi, gj) = (r[0] as u32, r[1] as u32);
+                if r[4] != 0.0 {
+                    dropped.push((gi.min(gj), gi.max(gj)));
+                    lost[gi as usize] += 1;
+                    lost[gj as usize] += 1;
+                } else {
+                    let mut h = M::Bond::default();
+                    h.as_mut_slice().copy_from_slice(&r[BOND_HEAD..]);
+                    let geom = BondGeom {
+                        length: r[2],
+                        beta: r[3],
+                    };
+                    bonds.push((gi, gj, geom, h));
+                }
+                at += BOND_HEAD + lh;
+            }
+            for _ in 0..nd {
+                dropped.push((all[at] as u32, all[at + 1] as u32));
+                at += 2;
+            }
+        }
+
+        // Positions back into a periodic box (reference positions move with them, so
+        // displacements are unchanged), then the new layout from where particles are now.
+        let domain = self.layout.domain.clone();
+        let mut pos = vec![[0.0; 3]; n];
+        for g in 0..n {
+            let (w, shift) = wrap(pos_of::<M>(&alter[g]), &domain);
+            pos[g] = w;
+            let a = alter[g].as_mut_slice();
+            a[..3].copy_from_slice(&w);
+            for (x, s) in x0[g].iter_mut().zip(shift) {
+                *x -= s;
+            }
+        }
+        let layout = Layout::new(self.layout.procs, &domain, &pos, self.layout.walls)?;
+        let plans = cell_plans(&layout);
+        let rank = self.plan.rank;
+        let plan = cube_plan(&layout, &plans, rank);
+
+        // This procCube's particles, owned then ghosts (images shifted).
+        let m = plan.global.len();
+        let g = |l: usize| plan.global[l] as usize;
+        let ids: Vec<u32> = (0..n as u32).collect();
+        let mut part = local_particles(
+            &self.sim.model,
+            &plan,
+            &ids,
+            &x0,
+            &volume,
+            &material,
+            &alter,
+        );
+        for l in 0..plan.n_owned {
+            part.force[l] = force[g(l)];
+        }
+        for l in 0..m {
+            part.fixed[l] = fixed[g(l)];
+        }
+
+        // Bonds this procCube evaluates: from the cell of one end to the same cell or a
+        // half-shell neighbour holding the other.
+        let grid = &layout.domain.grid;
+        let cell_at = |gid: u32| -> [i64; 3] {
+            let c = grid.coords(&pos[gid as usize]);
+            [c[0] as i64, c[1] as i64, c[2] as i64]
+        };
+        let held: HashMap<[i64; 3], usize> = plan
+            .cells
+            .held
+            .iter()
+            .enumerate()
+            .map(|(k, h)| (h.at, k))
+            .collect();
+        let (lo, hi) = (plan.cells.lo, plan.cells.hi);
+        let mut local_of_owned = HashMap::with_capacity(plan.n_owned);
+        for l in 0..plan.n_owned {
+            local_of_owned.insert(plan.global[l] as u32, l as u32);
+        }
+        let mut mine: Vec<(u32, u32, BondGeom, M::Bond)> = Vec::new();
+        for &(a, b, geom, h) in &bonds {
+            let (ca, cb) = (cell_at(a), cell_at(b));
+            let mut d = [0i64; 3];
+            for k in 0..3 {
+                d[k] = cb[k] - ca[k];
+                if domain.periodic[k] {
+                    let nk = grid.dims[k] as i64;
+                    d[k] = (d[k] + nk + 1).rem_euclid(nk) - 1;
+                }
+            }
+            if d.iter().any(|v| v.abs() > 1) {
+                return Err(format!(
+                    "an intact bond between particles {a} and {b} now spans more than one cell (from {:?} to {:?}): shuffling needs every intact bond shorter than a cell; raise [parallel] skin (cells are the horizon times 1 + skin)",
+                    pos[a as usize], pos[b as usize]
+                ));
+            }
+            let h32 = [d[0] as i32, d[1] as i32, d[2] as i32];
+            let (i, j, off) = if d == [0; 3] {
+                (a.min(b), a.max(b), [0i64; 3])
+            } else if HALF_SHELL.contains(&h32) {
+                (a, b, d)
+            } else {
+                (b, a, [-d[0], -d[1], -d[2]])
+            };
+            let ci = cell_at(i);
+            if (0..3).any(|k| ci[k] < lo[k] || ci[k] >= hi[k]) {
+                continue;
+            }
+            let li = local_of_owned[&i];
+            let target = [ci[0] + off[0], ci[1] + off[1], ci[2] + off[2]];
+            let cell = held
+                .get(&target)
+                .map(|&k| plan.cell_range[k].clone())
+                .unwrap_or_else(|| panic!("shuffle: no held cell at {target:?} for particle {j}"));
+            let lj = plan.global[cell.clone()]
+                .binary_search(&j)
+                .map(|p| (cell.start + p) as u32)
+                .unwrap_or_else(|_| panic!("shuffle: particle {j} is not in its cell"));
+            mine.push((li, lj, geom, h));
+        }
+        mine.sort_unstable_by_key(|&(i, j, _, _)| (i, j));
+        let mut offsets = vec![0u32; plan.n_owned + 1];
+        for &(i, ..) in &mine {
+            offsets[i as usize + 1] += 1;
+        }
+        for i in 0..plan.n_owned {
+            offsets[i + 1] += offsets[i];
+        }
+        let mut init_local = vec![0u32; m];
+        for l in 0..plan.n_owned {
+            init_local[l] = initial[g(l)];
+        }
+        let mut list: BondList<M::Bond> = BondList::assemble(
+            offsets,
+            mine.iter().map(|b| b.1).collect(),
+            mine.iter().map(|b| b.2).collect(),
+            init_local,
+        );
+        list.history = mine.iter().map(|b| b.3).collect();
+
+        // Dropped bonds live with the owner of their smaller id.
+        dropped.sort_unstable();
+        self.dropped = dropped
+            .into_iter()
+            .filter(|(a, _)| local_of_owned.contains_key(a))
+            .collect();
+        self.lost = (0..plan.n_owned).map(|l| lost[g(l)]).collect();
+
+        let mut local = vec![u32::MAX; n];
+        for l in 0..plan.n_owned {
+            local[g(l)] = l as u32;
+        }
+        let (mut constraints, loads, probes) = self.everywhere.share(&local);
+        // Reactions are reported before the next force evaluation: each procCube keeps its
+        // share (the sum over procCubes is what the history shows).
+        for (new, old) in constraints.iter_mut().zip(&self.sim.constraints) {
+            new.reaction.clone_from(&old.reaction);
+        }
+        self.sim.particles = part;
+        self.sim.bonds = list;
+        self.sim.constraints = constraints;
+        self.sim.loads = loads;
+        self.probes = probes;
+        self.wall().set_stages(plan.stages.clone());
+        self.plan = plan;
+        self.layout = layout;
+        // Ghosts are refreshed by the next step's exchange; forces came with their particles.
+        Ok(true)
+    }
+}
+
+fn pos_of<M: Model>(a: &M::Alter) -> [f64; 3] {
+    let s = a.as_slice();
+    [s[0], s[1], s[2]]
+}
+
+/// A position moved into the periodic box, and the shift taken off.
+fn wrap(p: [f64; 3], d: &crate::parallel::decomposition::Domain) -> ([f64; 3], [f64; 3]) {
+    let mut w = p;
+    let mut shift = [0.0; 3];
+    for a in 0..3 {
+        if d.periodic[a] {
+            let k = ((p[a] - d.grid.origin[a]) / d.period[a]).floor();
+            if k != 0.0 {
+                shift[a] = k * d.period[a];
+                w[a] = p[a] - shift[a];
+            }
+        }
+    }
+    (w, shift)
+}

@@ -1,0 +1,570 @@
+//! Implicit static solve: Newton's method on the equilibrium equations with the tangent
+//! stiffness assembled as a sparse matrix and factored by `faer` (sparse Cholesky; once bonds
+//! have broken, Cholesky with a slightly raised diagonal; LU if neither works), after a check
+//! that the factor fits in memory. For elastic states it reaches equilibrium in a few force
+//! evaluations per load step where relaxation needs thousands.
+//!
+//! The tangent is assembled from the engine's own force evaluation, for every model alike
+//! (bond-based, state-based, micropolar): columns by central differences, many at once. Two
+//! particles may be perturbed together when no particle's force depends on both: forces reach
+//! one bond length for a bond-based model and two for a model with a state pass (a state sums
+//! over a family), so particles more than twice that reach apart share a "colour". Each colour
+//! costs 2 force evaluations per degree of freedom. Rotations are perturbed through the model's
+//! own `drift`, so finite-rotation coordinates (quaternions) are handled as the integrator
+//! handles them.
+//!
+//! The tangent is kept while the Newton iterations at least halve the residual and rebuilt
+//! when they do not (modified Newton): a few broken bonds leave it usable. Loads are dead loads; supported DOFs are eliminated (their motion is imposed
+//! before the iterations, as in relaxation). One procCube only: the matrix is assembled and
+//! factored in one process.
+
+use crate::engine::particles::Particles;
+use crate::engine::timing::Phase;
+use crate::model::attributes::Attributes;
+use crate::model::{second_order, Model, Side};
+use crate::parallel::comm::{Reduce, Team};
+use crate::parallel::Cube;
+use crate::solve::adr::Relaxed;
+use faer::prelude::Solve;
+use faer::sparse::{SparseColMat, Triplet};
+use std::time::Instant;
+
+/// Relative size of the finite-difference perturbation: of the shortest bond for lengths, in
+/// radians for rotations.
+const PERTURBATION: f64 = 1e-6;
+
+enum Factor {
+    Cholesky(faer::sparse::linalg::solvers::Llt<usize, f64>),
+    Lu(Box<faer::sparse::linalg::solvers::Lu<usize, f64>>),
+}
+
+/// The factored tangent stiffness over the free degrees of freedom.
+pub struct Tangent {
+    /// Free DOF index of (particle · n₂ + k), or `usize::MAX` for a supported one.
+    index: Vec<usize>,
+    free: usize,
+    factor: Factor,
+    /// Force evaluations the assembly took.
+    pub evaluations: u64,
+    pub nonzeros: usize,
+    pub colours: usize,
+    /// "Cholesky", "Cholesky, shifted" or "LU".
+    pub method: &'static str,
+    pub seconds: f64,
+}
+
+/// Particles in colours: no two of a colour within `2 × reach` of each other (reference
+/// positions), greedily in store order.
+fn colour(x0: &[[f64; 3]], reach: f64) -> Vec<Vec<usize>> {
+    let d = 2.0 * reach * (1.0 + 1e-9);
+    let lo = x0.iter().fold([f64::INFINITY; 3], |m, p| {
+        [m[0].min(p[0]), m[1].min(p[1]), m[2].min(p[2])]
+    });
+    let key = |p: &[f64; 3]| [0, 1, 2].map(|a| ((p[a] - lo[a]) / d).floor() as i64);
+    let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
+    for (i, p) in x0.iter().enumerate() {
+        cells.entry(key(p)).or_default().push(i);
+    }
+    let mut of = vec![usize::MAX; x0.len()];
+    let mut colours: Vec<Vec<usize>> = Vec::new();
+    let mut taken: Vec<bool> = Vec::new();
+    for (i, p) in x0.iter().enumerate() {
+        taken.iter_mut().for_each(|t| *t = false);
+        let c = key(p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(list) = cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                        continue;
+                    };
+                    for &j in list {
+                        let q = x0[j];
+                        let r2 = (0..3).map(|a| (q[a] - p[a]).powi(2)).sum::<f64>();
+                        if of[j] != usize::MAX && r2 <= d * d {
+                            taken[of[j]] = true;
+                        }
+                    }
+                }
+            }
+        }
+        let k = taken.iter().position(|t| !t).unwrap_or(colours.len());
+        if k == colours.len() {
+            colours.push(Vec::new());
+            taken.push(false);
+        }
+        colours[k].push(i);
+        of[i] = k;
+    }
+    colours
+}
+
+/// Moves DOF `k` of a particle by `amount` through the model's drift (a rotation composes).
+fn nudge<M: Model>(model: &M, a: &mut M::Alter, k: usize, amount: f64) {
+    let n2 = second_order::<M>();
+    // A copy of the record, not a Vec: this runs 4·n₂ times per bond during assembly.
+    let saved = *a;
+    let s = a.as_mut_slice();
+    s[n2..2 * n2].fill(0.0);
+    s[n2 + k] = amount;
+    model.drift(a, 1.0);
+    a.as_mut_slice()[n2..2 * n2].copy_from_slice(&saved.as_slice()[n2..2 * n2]);
+}
+
+/// The tangent of a model without a state pass, bond by bond: each intact bond's forces on
+/// its two ends depend on those two ends only, so central differences of `Model::pair` give
+/// the bond's 2n₂ × 2n₂ block, 4n₂ bond calls per bond (as many as 4n₂ force passes). Lower
+/// triangle, as triplets over the free DOFs.
+fn bond_blocks<M: Model>(
+    model: &M,
+    p: &Particles<M>,
+    bonds: &crate::engine::bonds::BondList<M::Bond>,
+    index: &[usize],
+    h_length: f64,
+) -> Vec<Triplet<usize, usize, f64>> {
+    let n2 = second_order::<M>();
+    let w = 2 * n2;
+    let mut diagonal = vec![0.0; p.n_owned * n2 * n2];
+    let mut triplets = Vec::new();
+    let mut block = vec![0.0; w * w];
+    let (mut plus, mut minus) = (vec![0.0; w], vec![0.0; w]);
+    'bonds: for (i, j, b) in bonds.iter() {
+        if bonds.broken[b] {
+            continue;
+        }
+        let law = model.law(p.material[i], p.material[j]);
+        for col in 0..w {
+            let (end, k) = (col / n2, col % n2);
+            let h = if k < 3 { h_length } else { PERTURBATION };
+            for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                let (mut ai, mut aj) = (p.alter[i], p.alter[j]);
+                nudge(model, if end == 0 { &mut ai } else { &mut aj }, k, sign * h);
+                let side = |e: usize, a| Side::<M> {
+                    x0: &p.x0[e],
+                    volume: p.volume[e],
+                    material: p.material[e],
+                    alter: a,
+                    fixed: &p.fixed[e],
+                    state: &p.state[e],
+                };
+                let mut history = bonds.history[b];
+                // A bond that would break under a nudge is left out of the tangent: on the
+                // verge of breaking, it carries no stiffness worth counting, and half a
+                // difference (force on one side, none on the other) would be a huge entry
+                // that spoils the matrix's definiteness.
+                let Some((fi, fj)) = model.pair(
+                    &law,
+                    &side(i, &ai),
+                    &side(j, &aj),
+                    &bonds.geom[b],
+                    &mut history,
+                ) else {
+                    continue 'bonds;
+                };
+                out[..n2].copy_from_slice(&fi.as_slice()[..n2]);
+                out[n2..].copy_from_slice(&fj.as_slice()[..n2]);
+            }
+            for row in 0..w {
+                block[row * w + col] = -(plus[row] - minus[row]) / (2.0 * h);
+            }
+        }
+        let particle = [i, j];
+        for row in 0..w {
+            for col in 0..w {
+                let (pr, pc) = (particle[row / n2], particle[col / n2]);
+                let v = block[row * w + col];
+                if pr == pc {
+                    diagonal[(pr * n2 + row % n2) * n2 + col % n2] += v;
+                    continue;
+                }
+                let (r, c) = (index[pr * n2 + row % n2], index[pc * n2 + col % n2]);
+                if r != usize::MAX && c != usize::MAX && r >= c && v != 0.0 {
+                    triplets.push(Triplet::new(r, c, v));
+                }
+            }
+        }
+    }
+    for i in 0..p.n_owned {
+        for k in 0..n2 {
+            for l in 0..n2 {
+                let (r, c) = (index[i * n2 + k], index[i * n2 + l]);
+                let v = diagonal[(i * n2 + k) * n2 + l];
+                if r != usize::MAX && c != usize::MAX && r >= c && v != 0.0 {
+                    triplets.push(Triplet::new(r, c, v));
+                }
+            }
+        }
+    }
+    triplets
+}
+
+/// The factor may take at most this fraction of the memory the system reports available. The
+/// estimate below is already generous (twice the factor's values: the full micropolar beam's
+/// estimate was 26.5 GiB; the kernel killed it at 24 GiB), so all of it.
+const FACTOR_MEMORY_SHARE: f64 = 1.0;
+
+/// Refuses, with the sizes, a tangent whose Cholesky factor would not fit in memory: the
+/// symbolic factorization (ordering and column counts, cheap) gives the factor's nonzeros
+/// before any memory is spent on it. Without this check an oversized factor is not an error
+/// but the kernel's out-of-memory kill, after an hour and with the run's results lost.
+fn check_factor_memory(lower: &SparseColMat<usize, f64>, free: usize) -> Result<(), String> {
+    let Some(available) = available_memory() else {
+        return Ok(());
+    };
+    let symbolic = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
+        lower.symbolic(),
+        faer::Side::Lower,
+        Default::default(),
+        Default::default(),
+    )
+    .map_err(|e| format!("ordering the tangent stiffness: {e:?}"))?;
+    // Values, and about as much again for row indices and the numeric phase's workspace.
+    let needed = 2.0 * symbolic.len_val() as f64 * std::mem::size_of::<f64>() as f64;
+    if needed > FACTOR_MEMORY_SHARE * available {
+        let gib = |b: f64| b / (1u64 << 30) as f64;
+        return Err(format!(
+            "the implicit solve's factored tangent would need about {:.1} GiB ({} nonzeros over {free} free DOFs), more than the {:.1} GiB of memory available",
+            gib(needed),
+            symbolic.len_val(),
+            gib(FACTOR_MEMORY_SHARE * available)
+        ));
+    }
+    Ok(())
+}
+
+/// Bytes of memory available to new allocations (Linux `MemAvailable`), if known.
+fn available_memory() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
+}
+
+/// Relative shift of the diagonal that makes a nearly positive definite tangent factorable.
+const DIAGONAL_SHIFT: f64 = 1e-6;
+
+/// Cholesky of the lower triangle with each diagonal entry raised by [`DIAGONAL_SHIFT`] of
+/// itself. A tangent loses definiteness when a bond on the verge of breaking breaks under one
+/// finite-difference perturbation and not under the other; the shifted matrix is a slightly
+/// stiffer tangent, which modified Newton converges with, where an LU of a 3D lattice's
+/// matrix takes minutes (its column ordering alone).
+fn shifted_cholesky(
+    triplets: &[Triplet<usize, usize, f64>],
+    free: usize,
+) -> Option<faer::sparse::linalg::solvers::Llt<usize, f64>> {
+    let shifted: Vec<Triplet<usize, usize, f64>> = triplets
+        .iter()
+        .map(|t| {
+            let v = if t.row == t.col {
+                t.val + DIAGONAL_SHIFT * t.val.abs()
+            } else {
+                t.val
+            };
+            Triplet::new(t.row, t.col, v)
+        })
+        .collect();
+    SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &shifted)
+        .ok()?
+        .sp_cholesky(faer::Side::Lower)
+        .ok()
+}
+
+/// Factors the lower triangle given as triplets: Cholesky, else (with `broken` bonds) Cholesky
+/// with a slightly raised diagonal, else LU of the whole matrix.
+fn factor(
+    triplets: Vec<Triplet<usize, usize, f64>>,
+    index: Vec<usize>,
+    free: usize,
+    broken: usize,
+    evaluations: u64,
+    colours: usize,
+    start: Instant,
+) -> Result<Tangent, String> {
+    let nonzeros = triplets.len();
+    let lower = SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &triplets)
+        .map_err(|e| format!("assembling the tangent stiffness: {e:?}"))?;
+    check_factor_memory(&lower, free)?;
+    let (factor, method) = match lower.sp_cholesky(faer::Side::Lower) {
+        Ok(f) => (Factor::Cholesky(f), "Cholesky"),
+        // Only once bonds have broken: an intact scene that is not positive definite has a
+        // mechanism (supports leaving a rigid-body motion free), which a shift would hide.
+        Err(_) => match shifted_cholesky(&triplets, free).filter(|_| broken > 0) {
+            Some(f) => (Factor::Cholesky(f), "Cholesky, shifted"),
+            None => {
+                // Not positive definite (a model without a potential, or a mechanism): LU of
+                // the whole matrix.
+                let mut full = triplets.clone();
+                full.extend(
+                    triplets
+                        .iter()
+                        .filter(|t| t.row != t.col)
+                        .map(|t| Triplet::new(t.col, t.row, t.val)),
+                );
+                let a = SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &full)
+                    .map_err(|e| format!("assembling the tangent stiffness: {e:?}"))?;
+                let lu = a.sp_lu().map_err(|e| {
+                    format!("the tangent stiffness is singular ({e:?}): the supports leave a rigid-body motion or a loose particle free; support the body")
+                })?;
+                (Factor::Lu(Box::new(lu)), "LU")
+            }
+        },
+    };
+    Ok(Tangent {
+        index,
+        free,
+        factor,
+        evaluations,
+        nonzeros,
+        colours,
+        method,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+impl<M: Model> Cube<M> {
+    /// Assembles and factors the tangent stiffness at the current state. Bonds, their
+    /// history and the forces are left as they were.
+    pub fn assemble_tangent(&mut self) -> Result<Tangent, String> {
+        let start = Instant::now();
+        let n2 = second_order::<M>();
+        let n = self.sim.particles.n_owned;
+        if self.layout.domain.periodic.iter().any(|&p| p) {
+            return Err("the implicit solve does not handle periodic axes (it finds who feels whom from reference positions)".into());
+        }
+        if self.sim.particles.len() != n || self.sim.exchange.transport().size() != 1 {
+            return Err("the implicit solve runs on one procCube (--threads 1, no mpirun): the tangent is assembled and factored in one process".into());
+        }
+        // Supported DOFs.
+        let mut free = 0;
+        let index: Vec<usize> = (self.sim.free_dofs().iter())
+            .map(|&f| {
+                if f {
+                    free += 1;
+                    free - 1
+                } else {
+                    usize::MAX
+                }
+            })
+            .collect();
+        // Reach of a particle's force: the longest bond, twice over a state pass.
+        let sim = &self.sim;
+        let (mut longest, mut shortest) = (0.0f64, f64::INFINITY);
+        for g in &sim.bonds.geom {
+            longest = longest.max(g.length);
+            shortest = shortest.min(g.length);
+        }
+        if longest == 0.0 {
+            return Err("the implicit solve needs bonds: the scene has none".into());
+        }
+        if <M::State as Attributes>::LEN == 0 {
+            let triplets = bond_blocks(
+                &sim.model,
+                &sim.particles,
+                &sim.bonds,
+                &index,
+                PERTURBATION * shortest,
+            );
+            let broken = sim.bonds.broken_count();
+            return factor(triplets, index, free, broken, 4 * n2 as u64, 0, start);
+        }
+        // A state sums over a family: forces reach two bond lengths.
+        let reach = 2.0 * longest;
+        let colours = colour(&sim.particles.x0[..n], reach);
+        // Who can feel a particle: particles within `reach` (reference positions).
+        let x0 = sim.particles.x0[..n].to_vec();
+        let cell = reach * (1.0 + 1e-9);
+        let key = |p: &[f64; 3]| [0, 1, 2].map(|a| (p[a] / cell).floor() as i64);
+        let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
+        for (i, p) in x0.iter().enumerate() {
+            cells.entry(key(p)).or_default().push(i);
+        }
+        let near = |i: usize, out: &mut Vec<usize>| {
+            out.clear();
+            let (p, c) = (x0[i], key(&x0[i]));
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        if let Some(list) = cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                            for &j in list {
+                                let r2 = (0..3).map(|a| (x0[j][a] - p[a]).powi(2)).sum::<f64>();
+                                if r2 <= cell * cell {
+                                    out.push(j);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        };
+
+        let saved_alter = self.sim.particles.alter.clone();
+        let saved_broken = self.sim.bonds.broken.clone();
+        let broken = saved_broken.iter().filter(|&&b| b).count();
+        let saved_history = self.sim.bonds.history.clone();
+        let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
+        let mut plus = vec![0.0; n * n2];
+        let mut rows = Vec::new();
+        let mut evaluations = 0u64;
+        let owned = |p: &Particles<M>, out: &mut Vec<f64>| {
+            for (i, f) in p.force[..n].iter().enumerate() {
+                out[i * n2..(i + 1) * n2].copy_from_slice(&f.as_slice()[..n2]);
+            }
+        };
+        let mut minus = vec![0.0; n * n2];
+        for members in &colours {
+            for k in 0..n2 {
+                let h = if k < 3 {
+                    PERTURBATION * shortest
+                } else {
+                    PERTURBATION
+                };
+                let free_members: Vec<usize> = members
+                    .iter()
+                    .copied()
+                    .filter(|&i| index[i * n2 + k] != usize::MAX)
+                    .collect();
+                if free_members.is_empty() {
+                    continue;
+                }
+                for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                    let sim = &mut self.sim;
+                    for &i in &free_members {
+                        sim.particles.alter[i] = saved_alter[i];
+                        nudge(&sim.model, &mut sim.particles.alter[i], k, sign * h);
+                    }
+                    sim.compute_forces();
+                    evaluations += 1;
+                    owned(&sim.particles, out);
+                    for &i in &free_members {
+                        sim.particles.alter[i] = saved_alter[i];
+                    }
+                }
+                for &i in &free_members {
+                    let col = index[i * n2 + k];
+                    near(i, &mut rows);
+                    for &j in &rows {
+                        for l in 0..n2 {
+                            let row = index[j * n2 + l];
+                            if row == usize::MAX || row < col {
+                                continue; // the lower triangle is what Cholesky reads
+                            }
+                            // K = −∂F/∂u.
+                            let v = -(plus[j * n2 + l] - minus[j * n2 + l]) / (2.0 * h);
+                            if v != 0.0 {
+                                triplets.push(Triplet::new(row, col, v));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        self.sim.particles.alter = saved_alter;
+        self.sim.bonds.broken = saved_broken;
+        self.sim.bonds.history = saved_history;
+        self.sim.compute_forces();
+        factor(
+            triplets,
+            index,
+            free,
+            broken,
+            evaluations,
+            colours.len(),
+            start,
+        )
+    }
+
+    /// One load step of the implicit solve: supports and loads move to `sim.time + sim.dt`,
+    /// then Newton iterations with the (re)assembled tangent until the residual force is below
+    /// `tolerance` × (applied forces and reactions), as relaxation measures it. With
+    /// `stop_broken` > 0 the iterations end, unconverged, once that many bonds have broken:
+    /// the run ends there (`[time] stop_at_broken_bonds`), so a new tangent would be wasted.
+    pub fn implicit_step(
+        &mut self,
+        tangent: &mut Option<Tangent>,
+        tolerance: f64,
+        max_iterations: u64,
+        stop_broken: u64,
+    ) -> Result<Relaxed, String> {
+        let n2 = second_order::<M>();
+        let n = self.sim.particles.n_owned;
+        self.begin_load_step();
+
+        let mut evaluations = 0u64;
+        let mut newton = 0u64;
+        let mut residual;
+        let mut previous = f64::INFINITY;
+        loop {
+            self.sim.compute_forces();
+            evaluations += 1;
+            let t = Instant::now();
+            let p = &self.sim.particles;
+            let mut sums = vec![0.0];
+            for f in &p.force[..n] {
+                sums[0] += f.as_slice()[..n2].iter().map(|v| v * v).sum::<f64>();
+            }
+            for l in &self.sim.loads {
+                sums.extend_from_slice(&l.total(self.sim.time));
+            }
+            for c in &self.sim.constraints {
+                sums.extend_from_slice(&c.reaction);
+            }
+            Team::new(self.sim.exchange.transport()).reduce(&mut sums, Reduce::Sum);
+            let scale = sums[1..].iter().map(|x| x * x).sum::<f64>().sqrt();
+            residual = sums[0].sqrt() / scale.max(f64::MIN_POSITIVE);
+            self.sim.timing.lap(Phase::Integration, t);
+            if residual <= tolerance
+                || newton >= max_iterations
+                || (stop_broken > 0 && self.broken_count() as u64 >= stop_broken)
+            {
+                break;
+            }
+            let last_residual = std::mem::replace(&mut previous, residual);
+            // Rebuilt when the last iteration did not halve the residual: the tangent of an
+            // earlier state (modified Newton) no longer serves, as when many bonds have broken
+            // or the structure's rotations grow (geometric stiffness). A few broken bonds
+            // leave it good enough: the stale tangent is stiffer than the true one, so the
+            // iterations still converge, and rebuilding at every break made a cracking run
+            // spend nearly all its time assembling.
+            let slow = newton > 0 && residual > 0.5 * last_residual;
+            if slow || tangent.is_none() {
+                let k = self.assemble_tangent()?;
+                evaluations += k.evaluations;
+                *tangent = Some(k);
+            }
+            let t = Instant::now();
+            let k = tangent.as_ref().expect("assembled above");
+            let mut rhs = faer::Mat::<f64>::zeros(k.free, 1);
+            let p = &self.sim.particles;
+            for (i, f) in p.force[..n].iter().enumerate() {
+                for (l, &f) in f.as_slice()[..n2].iter().enumerate() {
+                    let r = k.index[i * n2 + l];
+                    if r != usize::MAX {
+                        rhs[(r, 0)] = f;
+                    }
+                }
+            }
+            match &k.factor {
+                Factor::Cholesky(f) => f.solve_in_place(rhs.as_mut()),
+                Factor::Lu(f) => f.solve_in_place(rhs.as_mut()),
+            }
+            // u += K⁻¹F, through the model's drift (rotations compose).
+            let sim = &mut self.sim;
+            for i in 0..n {
+                let a = sim.particles.alter[i].as_mut_slice();
+                for l in 0..n2 {
+                    let r = k.index[i * n2 + l];
+                    a[n2 + l] = if r == usize::MAX { 0.0 } else { rhs[(r, 0)] };
+                }
+                sim.model.drift(&mut sim.particles.alter[i], 1.0);
+            }
+            crate::solve::adr::zero_velocities(&mut sim.particles);
+            newton += 1;
+            sim.timing.lap(Phase::Integration, t);
+        }
+        Ok(Relaxed {
+            iterations: evaluations,
+            residual,
+            converged: residual <= tolerance,
+            diverged: false,
+        })
+    }
+}
