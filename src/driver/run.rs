@@ -8,7 +8,7 @@ use crate::model::attributes::Attributes;
 use crate::model::{Model, ModelVisitor};
 use crate::output::checkpoint::{self, Checkpoint};
 use crate::output::{Frames, History, Progress};
-use crate::parallel::comm::{f64s, Reduce, Team, Transport};
+use crate::parallel::comm::{f64s, Reduce, Transport};
 use crate::parallel::decomposition::{Layout, Procs, Walls};
 use crate::parallel::{self, Cube};
 use std::fmt::Write as _;
@@ -183,7 +183,7 @@ fn row<M: Model>(cube: &mut Cube<M>, damage: &[f64], n_probes: usize) -> Vec<f64
             .sum(),
     );
     let (step, time) = (sim.step as f64, sim.time);
-    let mut team = Team::new(cube.sim.exchange.transport());
+    let mut team = cube.team();
     team.reduce(&mut sums, Reduce::Sum);
     let max_damage = team.max(damage.iter().cloned().fold(0.0, f64::max));
     let mut r = vec![
@@ -224,7 +224,7 @@ fn first_blown_up<M: Model>(cube: &mut Cube<M>, limit: Option<f64>) -> Option<u3
         .map(|i| p.gid[i] as f64)
         .fold(f64::INFINITY, f64::min);
     let mut v = [mine];
-    Team::new(cube.sim.exchange.transport()).reduce(&mut v, Reduce::Min);
+    cube.team().reduce(&mut v, Reduce::Min);
     v[0].is_finite().then_some(v[0] as u32)
 }
 
@@ -295,7 +295,7 @@ fn blow_up<M: Model>(
 
 /// True on every worker if any worker failed (so that all stop together, none left waiting).
 fn any_failed<M: Model>(cube: &mut Cube<M>, failed: bool) -> bool {
-    Team::new(cube.sim.exchange.transport()).max(if failed { 1.0 } else { 0.0 }) > 0.0
+    cube.team().max(if failed { 1.0 } else { 0.0 }) > 0.0
 }
 
 /// Owned particles' global indices, damage and every declared record (alterable, fixed, state,
@@ -322,7 +322,7 @@ fn gather_frame<M: Model>(cube: &mut Cube<M>, damage: &[f64], store: &mut Option
         mine.extend_from_slice(p.state[i].as_slice());
         mine.extend_from_slice(p.force[i].as_slice());
     }
-    let all = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&mine));
+    let all = cube.team().gather(bytemuck::cast_slice(&mine));
     if let (Some(all), Some(store)) = (all, store.as_mut()) {
         for bytes in all {
             for rec in f64s(&bytes).chunks_exact(record) {
@@ -404,7 +404,7 @@ impl CheckpointPlan {
 /// all workers (each sees its own signal flag and clock; all must act at the same step).
 fn agree_on_stop<M: Model>(cube: &mut Cube<M>, stop: bool, clock_due: bool) -> (bool, bool) {
     let mut v = [stop as u8 as f64, clock_due as u8 as f64];
-    Team::new(cube.sim.exchange.transport()).reduce(&mut v, Reduce::Max);
+    cube.team().reduce(&mut v, Reduce::Max);
     (v[0] > 0.0, v[1] > 0.0)
 }
 
@@ -415,7 +415,7 @@ fn drive<M: Model>(
     mut store: Option<FrameStore<M>>,
     resume: Option<&Checkpoint>,
 ) -> Result<Option<Summary>, String> {
-    let root = cube.sim.exchange.transport().rank() == 0;
+    let root = cube.wall.transport().rank() == 0;
     let t = Instant::now();
     if let Some(c) = resume {
         c.restore_bonds(&mut cube);
@@ -470,7 +470,7 @@ fn drive<M: Model>(
     let mut mass_scale = 1.0f64;
     let mut relaxed: Option<crate::solve::adr::Relaxed> = None;
     let mut tangent: Option<crate::solve::implicit::Tangent> = None;
-    let workers = cube.sim.exchange.transport().size();
+    let workers = cube.wall.transport().size();
     let mut progress = Progress::new(plan.steps, root && plan.progress && !plan.quiet);
     let wall = Instant::now();
     let mut broken = 0usize;
@@ -481,7 +481,7 @@ fn drive<M: Model>(
         if step > first {
             let r = match &plan.relaxation {
                 None => {
-                    cube.sim.advance();
+                    cube.advance();
                     evaluations += 1;
                     None
                 }
@@ -533,7 +533,7 @@ fn drive<M: Model>(
         // Enough bonds broken ends the run here, as if this were the last step.
         let halted = plan.stop_at_broken > 0 && step > first && {
             let mut n = [cube.broken_count() as f64];
-            Team::new(cube.sim.exchange.transport()).reduce(&mut n, Reduce::Sum);
+            cube.team().reduce(&mut n, Reduce::Sum);
             n[0] >= plan.stop_at_broken as f64
         };
         stopped_at_broken |= halted;
@@ -659,7 +659,7 @@ fn drive<M: Model>(
         cube.sim.kinetic_energy(),
         cube.sim.strain_energy(),
     ];
-    Team::new(cube.sim.exchange.transport()).reduce(&mut totals, Reduce::Sum);
+    cube.team().reduce(&mut totals, Reduce::Sum);
     let damage = cube.damage();
     let mut mine: Vec<f64> = Vec::new();
     for (i, d) in damage.iter().enumerate() {
@@ -667,14 +667,14 @@ fn drive<M: Model>(
         mine.extend_from_slice(&cube.sim.particles.pos(i));
         mine.push(*d);
     }
-    let positions = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&mine));
+    let positions = cube.team().gather(bytemuck::cast_slice(&mine));
     let pairs: Vec<f64> = cube
         .broken_pairs()
         .iter()
         .flat_map(|&(a, b)| [a as f64, b as f64])
         .collect();
-    let pairs = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&pairs));
-    let traffic = cube.wall().traffic;
+    let pairs = cube.team().gather(bytemuck::cast_slice(&pairs));
+    let traffic = cube.wall.traffic;
     let tm = &cube.sim.timing;
     let balance = [
         cube.sim.particles.n_owned as f64,
@@ -686,7 +686,7 @@ fn drive<M: Model>(
             - tm.get(Phase::Output).as_secs_f64(),
         traffic.bytes as f64,
     ];
-    let balance = Team::new(cube.sim.exchange.transport()).gather(bytemuck::cast_slice(&balance));
+    let balance = cube.team().gather(bytemuck::cast_slice(&balance));
     if !root {
         return Ok(None);
     }

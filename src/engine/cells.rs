@@ -174,3 +174,31 @@ mod tests {
         assert_eq!(g.coords(&pts[1]), [2, 0, 0]);
     }
 }
+
+/// The cells of the whole scene and the axes that wrap around.
+#[derive(Clone, Debug)]
+pub struct Domain {
+    pub grid: CellGrid,
+    pub periodic: [bool; 3],
+    /// Length of each periodic axis; the grid spans it exactly.
+    pub period: [f64; 3],
+}
+
+impl Domain {
+    /// The same box with the cell count along each axis rounded down to a multiple of
+    /// `procs`, where that leaves at least one cell per procCube (and, on a periodic axis, at
+    /// least three cells, so that a cell's two neighbours along it are different cells).
+    pub fn for_procs(&self, procs: [usize; 3]) -> Domain {
+        let mut d = self.clone();
+        for (a, &p) in procs.iter().enumerate() {
+            let n = self.grid.dims[a];
+            let m = n - n % p.max(1);
+            let least = if self.periodic[a] { p.max(3) } else { p };
+            if m >= least && m != n {
+                d.grid.size[a] = self.grid.size[a] * n as f64 / m as f64;
+                d.grid.dims[a] = m;
+            }
+        }
+        d
+    }
+}

@@ -10,6 +10,7 @@ pub mod cells;
 pub mod correction;
 pub mod forces;
 pub mod particles;
+pub mod random;
 pub mod simulation;
 pub mod spectrum;
 pub mod timing;

@@ -5,8 +5,9 @@
 //!      → [state pass → reverse-sum → finish] → pair pass → reverse force sum
 //!      → loads, constraints → kick → constrain
 //! ```
-//! The exchange points are where the wall method's ghost messages go; a single procCube with
-//! no periodic axis has no ghosts and [`Local`] does nothing there.
+//! The exchange points are where the wall method's ghost messages go. The step is handed the
+//! exchange (`parallel::wall::WallExchange` on procCubes); a simulation on its own, with no
+//! ghosts, steps with [`Local`], which does nothing there.
 
 use crate::engine::bonds::BondList;
 use crate::engine::boundary::{Constraint, Load};
@@ -15,8 +16,6 @@ use crate::engine::particles::Particles;
 use crate::engine::timing::{Phase, Timing};
 use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model};
-use crate::parallel::comm::{Solo, Transport};
-use crate::parallel::wall::WallExchange;
 use std::time::Instant;
 
 /// Time integration of the generalized degrees of freedom.
@@ -47,20 +46,20 @@ pub trait Exchange<M: Model> {
     fn forward_state(&mut self, _p: &mut Particles<M>) {}
     /// Generalized forces on ghosts back to their owners (summed on arrival).
     fn reverse_force(&mut self, _p: &mut Particles<M>) {}
-    /// The byte mover underneath, for reductions and gathers at output time.
-    fn transport(&mut self) -> &mut dyn Transport;
-    /// The wall-method exchange, if this is one.
-    fn wall(&mut self) -> Option<&mut WallExchange> {
-        None
-    }
 }
 
-/// One procCube, no ghosts: nothing to move.
-#[derive(Default)]
-pub struct Local(Solo);
+/// No ghosts: nothing to move.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Local;
 impl<M: Model> Exchange<M> for Local {
-    fn transport(&mut self) -> &mut dyn Transport {
-        &mut self.0
+    fn forward(&mut self, p: &mut Particles<M>) {
+        // Ghosts stepped without their exchange would keep stale positions: a procCube steps
+        // through `Cube::advance`, never through its simulation alone.
+        assert_eq!(
+            p.len(),
+            p.n_owned,
+            "a store with ghosts stepped without its wall exchange"
+        );
     }
 }
 
@@ -75,7 +74,6 @@ pub struct Simulation<M: Model> {
     pub time: f64,
     pub step: u64,
     pub timing: Timing,
-    pub exchange: Box<dyn Exchange<M> + Send>,
 }
 
 impl<M: Model> Simulation<M> {
@@ -91,7 +89,6 @@ impl<M: Model> Simulation<M> {
             time: 0.0,
             step: 0,
             timing: Timing::default(),
-            exchange: Box::new(Local::default()),
         }
     }
 
@@ -110,23 +107,28 @@ impl<M: Model> Simulation<M> {
         free
     }
 
-    /// Forces at the current state, loads and constraint reactions included. Returns the
-    /// number of bonds that broke.
+    /// Forces at the current state, loads and constraint reactions included, with no ghosts.
+    /// Returns the number of bonds that broke.
     pub fn compute_forces(&mut self) -> usize {
+        self.compute_forces_with(&mut Local)
+    }
+
+    /// [`Simulation::compute_forces`] with ghost data moved by `exchange`.
+    pub fn compute_forces_with(&mut self, exchange: &mut impl Exchange<M>) -> usize {
         let p = &mut self.particles;
         let mut t = Instant::now();
-        self.exchange.forward(p);
+        exchange.forward(p);
         t = self.timing.lap(Phase::Communication, t);
         if <M::State as Attributes>::LEN > 0 {
             forces::state_pass(&self.model, p, &mut self.bonds);
-            self.exchange.reverse_state(p);
+            exchange.reverse_state(p);
             forces::finish_state(&self.model, p);
-            self.exchange.forward_state(p);
+            exchange.forward_state(p);
             t = self.timing.lap(Phase::State, t);
         }
         let broken = forces::pair_pass(&self.model, p, &mut self.bonds);
         t = self.timing.lap(Phase::Forces, t);
-        self.exchange.reverse_force(p);
+        exchange.reverse_force(p);
         t = self.timing.lap(Phase::Communication, t);
         for load in &self.loads {
             load.apply(p, self.time);
@@ -178,8 +180,13 @@ impl<M: Model> Simulation<M> {
         }
     }
 
-    /// Advances one time step; returns the number of bonds that broke in it.
+    /// Advances one time step with no ghosts; returns the number of bonds that broke in it.
     pub fn advance(&mut self) -> usize {
+        self.advance_with(&mut Local)
+    }
+
+    /// [`Simulation::advance`] with ghost data moved by `exchange`.
+    pub fn advance_with(&mut self, exchange: &mut impl Exchange<M>) -> usize {
         let (dt, t0) = (self.dt, self.time);
         let start = Instant::now();
         self.advance_first_order(dt);
@@ -194,7 +201,7 @@ impl<M: Model> Simulation<M> {
         self.time = t0 + dt;
         self.step += 1;
         self.timing.lap(Phase::Integration, start);
-        let broken = self.compute_forces();
+        let broken = self.compute_forces_with(exchange);
         let start = Instant::now();
         if self.integrator == Integrator::VelocityVerlet {
             self.kick(0.5 * dt);

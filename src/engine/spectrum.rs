@@ -129,7 +129,7 @@ pub fn stiffest_mode<M: Model>(
         .iter()
         .map(|&d| {
             let key = (sim.particles.gid[d / n2] as u64) * n2 as u64 + (d % n2) as u64;
-            (crate::input::geometry::splitmix64(key) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            (crate::engine::random::splitmix64(key) >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         })
         .collect();
     let norm = dot(&q, &q).sqrt();

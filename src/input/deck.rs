@@ -9,12 +9,12 @@ use crate::engine::boundary::{History, Motion, TEMPERATURE};
 use crate::engine::simulation::Integrator;
 use crate::input::bars::Prestrain;
 use crate::input::geometry::{Bar, Lattice, Op, Shape};
+use crate::input::procs::{Procs, Walls};
 use crate::input::units::{
     AccelerationVector, Area, Density, EnergyPerArea, ForceVector, Length, Micromodulus, Position,
     Stress, Time, UnitSystem, Vector, VelocityVector,
 };
 use crate::model::{Material, MaterialKind, OptionValue};
-use crate::parallel::decomposition::{Procs, Walls};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::fmt;

@@ -313,20 +313,14 @@ impl Lattice {
         }
         let mut h = self.seed ^ 0x9E37_79B9_7F4A_7C15;
         for k in key {
-            h = splitmix64(h ^ (*k as u64));
+            h = crate::engine::random::splitmix64(h ^ (*k as u64));
         }
         [0, 1, 2].map(|e| {
-            let u = (splitmix64(h.wrapping_add(e as u64)) >> 11) as f64 / (1u64 << 53) as f64;
+            let u = (crate::engine::random::splitmix64(h.wrapping_add(e as u64)) >> 11) as f64
+                / (1u64 << 53) as f64;
             (2.0 * u - 1.0) * self.jitter * self.spacing
         })
     }
-}
-
-pub(crate) fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -5,5 +5,6 @@
 pub mod bars;
 pub mod deck;
 pub mod geometry;
+pub mod procs;
 pub mod setup;
 pub mod units;

@@ -4,6 +4,7 @@
 use crate::engine::bonds::BondList;
 use crate::engine::boundary::{Constraint, Load, TEMPERATURE};
 use crate::engine::cells::CellGrid;
+use crate::engine::cells::Domain;
 use crate::engine::particles::Particles;
 use crate::engine::simulation::{stable_time_step, Simulation};
 use crate::input::bars::BarBonds;
@@ -11,7 +12,6 @@ use crate::input::deck::{CriticalStep, DeckError, LoadKind, Region, RunLength, S
 use crate::input::geometry;
 use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model, ModelBuild, ModelVisitor};
-use crate::parallel::decomposition::Domain;
 use std::time::Instant;
 
 /// A simulation built from a deck, with what the deck's checks found.

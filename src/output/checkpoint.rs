@@ -15,7 +15,7 @@ use crate::engine::simulation::Integrator;
 use crate::input::setup::Setup;
 use crate::model::attributes::Attributes;
 use crate::model::Model;
-use crate::parallel::comm::{f64s, Team};
+use crate::parallel::comm::f64s;
 use crate::parallel::Cube;
 use hdf5_pure::AttrValue;
 use std::collections::HashMap;
@@ -169,7 +169,7 @@ impl Checkpoint {
         let (step, time, dt) = (cube.sim.step, cube.sim.time, cube.sim.dt);
         let integrator = cube.sim.integrator.name().to_string();
         let n = cube.global_particles;
-        let mut team = Team::new(cube.sim.exchange.transport());
+        let mut team = cube.team();
         let particles = team.gather(bytemuck::cast_slice(&mine));
         let bonds = team.gather(bytemuck::cast_slice(&bonds));
         let (particles, bonds) = (particles?, bonds?);

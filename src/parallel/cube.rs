@@ -13,7 +13,7 @@ use crate::engine::simulation::Simulation;
 use crate::input::setup::Setup;
 use crate::model::attributes::Attributes;
 use crate::model::Model;
-use crate::parallel::comm::Transport;
+use crate::parallel::comm::{Team, Transport};
 use crate::parallel::decomposition::{
     cell_plans, cube_plan, CellPlan, CubePlan, Layout, Procs, Walls,
 };
@@ -22,6 +22,8 @@ use crate::parallel::wall::WallExchange;
 /// One procCube ready to step.
 pub struct Cube<M: Model> {
     pub sim: Simulation<M>,
+    /// The ghost messages to and from the neighbouring procCubes, over the run's transport.
+    pub wall: WallExchange,
     pub plan: CubePlan,
     pub layout: Layout,
     /// Probe number and local index, for the probes whose particle this procCube owns.
@@ -184,9 +186,9 @@ pub fn build_cube<M: Model>(
     sim.integrator = setup.sim.integrator;
     sim.constraints = constraints;
     sim.loads = loads;
-    let stages = plan.stages.clone();
-    sim.exchange = Box::new(WallExchange::new(stages, transport));
+    let wall = WallExchange::new(plan.stages.clone(), transport);
     Cube {
+        wall,
         lost: vec![0; plan.n_owned],
         sim,
         plan,
@@ -234,7 +236,7 @@ impl<M: Model> Cube<M> {
     /// there) and computes the first forces. Every worker must call it, as it exchanges.
     pub fn start(&mut self) {
         let mut counts: Vec<f64> = self.sim.bonds.initial.iter().map(|&c| c as f64).collect();
-        self.wall().reverse(&mut counts, |a, b| *a += b);
+        self.wall.reverse(&mut counts, |a, b| *a += b);
         for (c, v) in self.sim.bonds.initial.iter_mut().zip(&counts) {
             *c = *v as u32;
         }
@@ -242,27 +244,35 @@ impl<M: Model> Cube<M> {
             let sim = &mut self.sim;
             let mut sums =
                 crate::engine::forces::bond_fixed_sums(&sim.model, &sim.particles, &sim.bonds);
-            self.wall()
+            self.wall
                 .reverse(&mut sums, crate::model::attributes::add_assign);
             let p = &mut self.sim.particles;
             for (f, s) in p.fixed.iter_mut().zip(&sums).take(p.n_owned) {
                 crate::model::attributes::add_assign(f, s);
             }
             let mut fixed = std::mem::take(&mut self.sim.particles.fixed);
-            self.wall().forward(&mut fixed, false);
+            self.wall.forward(&mut fixed, false);
             self.sim.particles.fixed = fixed;
         }
         for c in &self.sim.constraints {
             c.set_velocity(&mut self.sim.particles, self.sim.time, self.sim.dt);
         }
-        self.sim.compute_forces();
+        self.compute_forces();
     }
 
-    pub fn wall(&mut self) -> &mut WallExchange {
-        self.sim
-            .exchange
-            .wall()
-            .expect("a procCube always has a wall exchange")
+    /// One time step, ghosts exchanged with the neighbours; the bonds that broke in it.
+    pub fn advance(&mut self) -> usize {
+        self.sim.advance_with(&mut self.wall)
+    }
+
+    /// Forces at the current state, ghosts exchanged; the bonds that broke.
+    pub fn compute_forces(&mut self) -> usize {
+        self.sim.compute_forces_with(&mut self.wall)
+    }
+
+    /// Reductions and gathers over every procCube of the run, in rank order.
+    pub fn team(&mut self) -> Team<&mut dyn Transport> {
+        Team::new(self.wall.transport())
     }
 
     /// Damage of the owned particles: broken over initial bonds, counting bonds evaluated on
@@ -277,7 +287,7 @@ impl<M: Model> Cube<M> {
                 broken[j] += 1.0;
             }
         }
-        self.wall().reverse(&mut broken, |a, b| *a += b);
+        self.wall.reverse(&mut broken, |a, b| *a += b);
         let b = &self.sim.bonds;
         (0..self.sim.particles.n_owned)
             .map(|i| {
@@ -370,15 +380,15 @@ impl<M: Model> Cube<M> {
         shuffle_every: u64,
     ) -> Result<Timed, String> {
         use crate::engine::timing::Phase;
-        use crate::parallel::comm::{Reduce, Team};
+        use crate::parallel::comm::Reduce;
         self.start();
         self.sim.timing = Default::default();
-        let before = self.wall().traffic;
+        let before = self.wall.traffic;
         // A reduction is a barrier: everyone starts the clock together.
-        Team::new(self.sim.exchange.transport()).sum(0.0);
+        self.team().sum(0.0);
         let t = std::time::Instant::now();
         for step in 1..=steps {
-            self.sim.advance();
+            self.advance();
             if shuffle_every > 0 && step % shuffle_every == 0 {
                 let t = std::time::Instant::now();
                 self.shuffle()?;
@@ -386,18 +396,18 @@ impl<M: Model> Cube<M> {
             }
         }
         let secs = t.elapsed().as_secs_f64();
-        let after = self.wall().traffic;
+        let after = self.wall.traffic;
         let mut v = [
             secs,
             self.sim.timing.get(Phase::Communication).as_secs_f64(),
         ];
-        Team::new(self.sim.exchange.transport()).reduce(&mut v, Reduce::Max);
+        self.team().reduce(&mut v, Reduce::Max);
         let mut s = [
             self.sim.bonds.len() as f64,
             self.broken_count() as f64,
             (after.bytes - before.bytes) as f64 / steps.max(1) as f64,
         ];
-        Team::new(self.sim.exchange.transport()).reduce(&mut s, Reduce::Sum);
+        self.team().reduce(&mut s, Reduce::Sum);
         Ok(Timed {
             seconds: v[0],
             comm_seconds: v[1],

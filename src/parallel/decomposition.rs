@@ -10,49 +10,15 @@
 //! so sender and receiver agree on every message without negotiating.
 
 use crate::engine::bonds::{BondList, Families};
-use crate::engine::cells::{CellGrid, HALF_SHELL};
+pub use crate::engine::cells::Domain;
+use crate::engine::cells::HALF_SHELL;
+pub use crate::input::procs::{Procs, Walls};
 use std::ops::Range;
 
 /// The five ghost messages in order, as (axis, direction): east, west, north, up, down.
 pub const STAGES: [(usize, i64); 5] = [(0, 1), (0, -1), (1, 1), (2, 1), (2, -1)];
 pub const STAGE_NAMES: [&str; 5] = ["east", "west", "north", "up", "down"];
 const AXES: [&str; 3] = ["x", "y", "z"];
-
-/// The procCube counts a deck or the command line asks for.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Procs {
-    /// Chosen from the particle distribution and the box shape for a number of workers.
-    Auto,
-    Given([usize; 3]),
-}
-
-/// What a ghost message carries.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Walls {
-    /// Every cell the sender holds in its face layer (received ones included), as the thesis sends.
-    #[default]
-    Whole,
-    /// Only the cells the receiver uses or passes on (the thesis's beams, columns and cornices).
-    Trimmed,
-}
-
-impl Walls {
-    pub fn name(self) -> &'static str {
-        match self {
-            Walls::Whole => "whole",
-            Walls::Trimmed => "trimmed",
-        }
-    }
-}
-
-/// The cells of the whole scene and the axes that wrap around.
-#[derive(Clone, Debug)]
-pub struct Domain {
-    pub grid: CellGrid,
-    pub periodic: [bool; 3],
-    /// Length of each periodic axis; the grid spans it exactly.
-    pub period: [f64; 3],
-}
 
 /// ProcCubes as ranges of cell layers along each axis.
 #[derive(Clone, Debug)]
@@ -67,25 +33,6 @@ pub struct Layout {
     /// Store indices of the particles of cell c: `order[start[c]..start[c + 1]]`, increasing.
     pub start: Vec<u32>,
     pub order: Vec<u32>,
-}
-
-impl Domain {
-    /// The same box with the cell count along each axis rounded down to a multiple of
-    /// `procs`, where that leaves at least one cell per procCube (and, on a periodic axis, at
-    /// least three cells, so that a cell's two neighbours along it are different cells).
-    pub fn for_procs(&self, procs: [usize; 3]) -> Domain {
-        let mut d = self.clone();
-        for (a, &p) in procs.iter().enumerate() {
-            let n = self.grid.dims[a];
-            let m = n - n % p.max(1);
-            let least = if self.periodic[a] { p.max(3) } else { p };
-            if m >= least && m != n {
-                d.grid.size[a] = self.grid.size[a] * n as f64 / m as f64;
-                d.grid.dims[a] = m;
-            }
-        }
-        d
-    }
 }
 
 /// Bond work of each layer of cells along each axis: what a procCube taking those layers

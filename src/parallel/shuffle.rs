@@ -19,7 +19,7 @@ use crate::engine::bonds::BondList;
 use crate::engine::cells::HALF_SHELL;
 use crate::model::attributes::Attributes;
 use crate::model::{BondGeom, Model};
-use crate::parallel::comm::{f64s, Team};
+use crate::parallel::comm::f64s;
 use crate::parallel::decomposition::{cell_plans, cube_plan, Layout};
 use crate::parallel::{local_particles, Cube};
 use std::collections::HashMap;
@@ -54,7 +54,7 @@ impl<M: Model> Cube<M> {
                 }
             }
         }
-        Team::new(self.sim.exchange.transport()).max(if left { 1.0 } else { 0.0 }) > 0.0
+        self.team().max(if left { 1.0 } else { 0.0 }) > 0.0
     }
 
     /// Redraws ownership from current positions if any particle left its procCube. Every worker
@@ -95,7 +95,7 @@ impl<M: Model> Cube<M> {
             mine.extend_from_slice(&[a as f64, c as f64]);
         }
         // Everyone gets everything: gather on the root, then the root's concatenation to all.
-        let mut team = Team::new(self.sim.exchange.transport());
+        let mut team = self.team();
         let mut all: Vec<u8> = team
             .gather(bytemuck::cast_slice(&mine))
             .map(|parts| parts.concat())
@@ -305,7 +305,7 @@ impl<M: Model> Cube<M> {
         self.sim.constraints = constraints;
         self.sim.loads = loads;
         self.probes = probes;
-        self.wall().set_stages(plan.stages.clone());
+        self.wall.set_stages(plan.stages.clone());
         self.plan = plan;
         self.layout = layout;
         // Ghosts are refreshed by the next step's exchange; forces came with their particles.

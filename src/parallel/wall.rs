@@ -125,6 +125,11 @@ impl WallExchange {
     pub fn stages(&self) -> &[Stage] {
         &self.stages
     }
+
+    /// The byte mover underneath, for reductions and gathers.
+    pub fn transport(&mut self) -> &mut dyn Transport {
+        &mut *self.transport
+    }
 }
 
 impl<M: Model> Exchange<M> for WallExchange {
@@ -143,11 +148,5 @@ impl<M: Model> Exchange<M> for WallExchange {
     }
     fn reverse_force(&mut self, p: &mut Particles<M>) {
         self.reverse(&mut p.force, add_assign);
-    }
-    fn transport(&mut self) -> &mut dyn Transport {
-        &mut *self.transport
-    }
-    fn wall(&mut self) -> Option<&mut WallExchange> {
-        Some(self)
     }
 }

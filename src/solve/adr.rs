@@ -34,7 +34,7 @@ use crate::engine::simulation::Simulation;
 use crate::engine::timing::Phase;
 use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model};
-use crate::parallel::comm::{Reduce, Team};
+use crate::parallel::comm::Reduce;
 use crate::parallel::Cube;
 use std::time::Instant;
 
@@ -219,7 +219,7 @@ impl<M: Model> Cube<M> {
         let n2 = second_order::<M>();
         let n = self.sim.particles.n_owned;
         let mut iterations = 1;
-        self.sim.compute_forces();
+        self.compute_forces();
         // Forces of this and of the previous iteration, two buffers swapped: no allocation per
         // iteration.
         let mut previous: Vec<f64> = Vec::with_capacity(n * n2);
@@ -246,7 +246,7 @@ impl<M: Model> Cube<M> {
                 }
             }
             self.sim.timing.lap(Phase::Integration, t);
-            self.sim.compute_forces();
+            self.compute_forces();
             iterations += 1;
             let t = Instant::now();
             self.owned_forces(n2, &mut force);
@@ -280,7 +280,7 @@ impl<M: Model> Cube<M> {
             for c in &self.sim.constraints {
                 all.extend_from_slice(&c.reaction);
             }
-            Team::new(self.sim.exchange.transport()).reduce(&mut all, Reduce::Sum);
+            self.team().reduce(&mut all, Reduce::Sum);
             let scale = all[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
             residual = all[2].sqrt() / scale.max(f64::MIN_POSITIVE);
             // A crack can raise the residual to about the applied forces, never a thousand

@@ -22,7 +22,7 @@ use crate::engine::particles::Particles;
 use crate::engine::timing::Phase;
 use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model, Side};
-use crate::parallel::comm::{Reduce, Team};
+use crate::parallel::comm::Reduce;
 use crate::parallel::Cube;
 use crate::solve::adr::Relaxed;
 use faer::prelude::Solve;
@@ -330,7 +330,7 @@ impl<M: Model> Cube<M> {
         if self.layout.domain.periodic.iter().any(|&p| p) {
             return Err("the implicit solve does not handle periodic axes (it finds who feels whom from reference positions)".into());
         }
-        if self.sim.particles.len() != n || self.sim.exchange.transport().size() != 1 {
+        if self.sim.particles.len() != n || self.wall.transport().size() != 1 {
             return Err("the implicit solve runs on one procCube (--threads 1, no mpirun): the tangent is assembled and factored in one process".into());
         }
         // Supported DOFs.
@@ -431,7 +431,7 @@ impl<M: Model> Cube<M> {
                         sim.particles.alter[i] = saved_alter[i];
                         nudge(&sim.model, &mut sim.particles.alter[i], k, sign * h);
                     }
-                    sim.compute_forces();
+                    sim.compute_forces_with(&mut self.wall);
                     evaluations += 1;
                     owned(&sim.particles, out);
                     for &i in &free_members {
@@ -460,7 +460,7 @@ impl<M: Model> Cube<M> {
         self.sim.particles.alter = saved_alter;
         self.sim.bonds.broken = saved_broken;
         self.sim.bonds.history = saved_history;
-        self.sim.compute_forces();
+        self.compute_forces();
         factor(
             triplets,
             index,
@@ -493,7 +493,7 @@ impl<M: Model> Cube<M> {
         let mut residual;
         let mut previous = f64::INFINITY;
         loop {
-            self.sim.compute_forces();
+            self.compute_forces();
             evaluations += 1;
             let t = Instant::now();
             let p = &self.sim.particles;
@@ -507,7 +507,7 @@ impl<M: Model> Cube<M> {
             for c in &self.sim.constraints {
                 sums.extend_from_slice(&c.reaction);
             }
-            Team::new(self.sim.exchange.transport()).reduce(&mut sums, Reduce::Sum);
+            self.team().reduce(&mut sums, Reduce::Sum);
             let scale = sums[1..].iter().map(|x| x * x).sum::<f64>().sqrt();
             residual = sums[0].sqrt() / scale.max(f64::MIN_POSITIVE);
             self.sim.timing.lap(Phase::Integration, t);
