@@ -1,4 +1,4 @@
-//! The thesis's reinforced-concrete model (Sakhavand 2011, appendix A `ConcConc`; THEORY.md §8).
+//! The thesis's reinforced-concrete model (Sakhavand 2011, appendix A `ConcConc`; docs/theory.md §8).
 //!
 //! * concrete–concrete: f = E′·s between the compressive and tensile critical stretches
 //!   s_c < s < s_t, E′ = 6E/(πδ⁴(1−2ν)) (thesis eq. 4.1); outside that range the bond breaks for

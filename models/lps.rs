@@ -1,5 +1,5 @@
 //! LPS: Silling's linear peridynamic solid, ordinary state-based (Silling et al. 2007;
-//! THEORY.md §2), any Poisson's ratio.
+//! docs/theory.md §2), any Poisson's ratio.
 //!
 //! * weighted volume m_i = Σ_j ω L² V_j β, summed once over the reference family (broken bonds
 //!   keep counting, as in Peridigm);

@@ -1,5 +1,5 @@
 //! Micropolar bond-based peridynamics: six degrees of freedom per particle (displacement and
-//! rotation), a bond force and two unequal bond moments (THEORY.md §3, marked DERIVED there:
+//! rotation), a bond force and two unequal bond moments (docs/theory.md §3, marked DERIVED there:
 //! energy equivalence, not a published law; docs/models.md lists what was verified).
 //!
 //! Each particle carries an orientation Q (a unit quaternion, integrated, and its rotation
@@ -7,7 +7,7 @@
 //! n₀ = ξ/L, current vector y and d_i = Q_i n₀:
 //!
 //! * s = (|y| − L)/L, g = y/L − ½(d_i + d_j) (g = s n + γ for small motion, with γ the
-//!   shear of THEORY.md §3), and φ the rotation from Q_i to Q_j;
+//!   shear of docs/theory.md §3), and φ the rotation from Q_i to Q_j;
 //! * micropotential w = ½L[(c_n − c_s) s² + c_s |g|²] + κ_φ (1 − cos|φ|)
 //!   (= ½L(c_n s² + c_s|γ|²) + ½κ_φ|φ|² for small motion);
 //! * force on i f = (c_n − c_s) s y/|y| + c_s g (j gets −f); moments
@@ -372,7 +372,7 @@ impl Model for Micropolar {
 
     fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> Force6 {
         let t = law.c_max / geom.length;
-        // THEORY.md §4: rotations bound the step through c_s L/4 + κ_φ.
+        // docs/theory.md §4: rotations bound the step through c_s L/4 + κ_φ.
         let r = law.cs * geom.length / 4.0 + law.kappa;
         Force6 {
             force: [t; 3],

@@ -2,7 +2,7 @@
 //!
 //! f_ij = c·s·β·V_i·V_j along the current bond, c = 18K/(πδ⁴) (ν = ¼ is implied), and the bond
 //! breaks for good once s > s0, with s0 given or from the fracture energy: s0 = √(5G0/(9Kδ)).
-//! THEORY.md §1. A bond between two materials takes the series stiffness 2c_a c_b/(c_a + c_b)
+//! docs/theory.md §1. A bond between two materials takes the series stiffness 2c_a c_b/(c_a + c_b)
 //! and the smaller critical stretch.
 
 use crate::model::{bond_based_lame, check_options, stretch, BondGeom, Model, ModelBuild, Side};

@@ -1,4 +1,4 @@
-//! Thermomechanical PMB: the PMB bond (THEORY.md §1) plus temperature as a first-order degree
+//! Thermomechanical PMB: the PMB bond (docs/theory.md §1) plus temperature as a first-order degree
 //! of freedom with peridynamic heat conduction (thesis Table 2.1; Bobaru & Duangpanya 2010).
 //!
 //! * Heat into i through bond ij: q = κ_ij (T_j − T_i)/|ξ| · V_i V_j β; j receives −q. The
@@ -6,7 +6,7 @@
 //!   continuum family ∫|ξ| dV = πδ⁴. PDQ uses the particle's discrete family instead,
 //!   κ_ij = 12k / (S_i + S_j) with S_i = Σ_j |ξ| V_j β (as LPS uses its discrete weighted
 //!   volume): the conductivity of a cubic lattice is then exactly k in the bulk, and particles
-//!   near a surface, with smaller S, conduct more (like the volume correction of THEORY.md §6).
+//!   near a surface, with smaller S, conduct more (like the volume correction of docs/theory.md §6).
 //! * ρ c_p V Ṫ = Σ q, integrated by forward Euler (the engine's first-order DOFs).
 //! * Thermal expansion couples temperature into the mechanical stretch:
 //!   s = (|y| − |ξ|)/|ξ| − α (½(T_i + T_j) − T_ref), with α = `thermal_expansion` (default 0)

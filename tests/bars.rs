@@ -1,4 +1,4 @@
-//! Bars as one-dimensional members (src/bars.rs): a bar carries E·A·ε whatever its area and the
+//! Bars as one-dimensional members (src/input/bars.rs): a bar carries E·A·ε whatever its area and the
 //! lattice spacing, and a prestrained bar held at both ends pulls with E·A·ε_p.
 
 use pdq::driver::run::{run, RunOptions};

@@ -1,4 +1,9 @@
-//! `pdq run` and `pdq check`: a deck's scene laid out on procCubes, stepped with its outputs
-//! and stop criteria, summarised.
+//! `pdq run` and `pdq check`: a deck's scene laid out on procCubes ([`run`]), stepped by its
+//! solver with its outputs and stop criteria observing (`step_loop`), recorded (`record`:
+//! the typed history row, frames and the final state gathered by global id), summarised;
+//! `check` describes a deck without running it.
 
+mod check;
+mod record;
 pub mod run;
+mod step_loop;

@@ -23,7 +23,7 @@ pub struct BondList<H: Attributes> {
     pub initial: Vec<u32>,
 }
 
-/// Partial-volume factor β of a bond of length `l` (THEORY.md §6, as LAMMPS's `vfrac_scale`):
+/// Partial-volume factor β of a bond of length `l` (docs/theory.md §6, as LAMMPS's `vfrac_scale`):
 /// 1 up to δ − dx/2, then falling linearly to (δ + dx/2 − l)/dx at the horizon.
 pub fn partial_volume(l: f64, horizon: f64, dx: f64) -> f64 {
     if l <= horizon - 0.5 * dx {

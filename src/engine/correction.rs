@@ -1,5 +1,5 @@
 //! The energy surface correction of bond-based models (Madenci & Oterkus 2014; Le & Bobaru
-//! 2018; THEORY.md §6).
+//! 2018; docs/theory.md §6).
 //!
 //! A particle near a surface misses part of its family and is too soft; on a lattice even an
 //! interior particle's discrete family differs from the continuum integral the micromodulus
@@ -84,7 +84,7 @@ pub fn bond_factor(xi: [f64; 3], gi: &[f64; 3], gj: &[f64; 3]) -> f64 {
 }
 
 /// Multiplies every bond's β by its G_ij; `g(i)` gives the factors of store particle i. Bonds
-/// for which `skip(i, j)` holds are left alone: a bar's own bonds, which `bars.rs` scales as a
+/// for which `skip(i, j)` holds are left alone: a bar's own bonds, which `input/bars.rs` scales as a
 /// whole (the factors of a bar particle come from the body around it, not from the bar).
 pub fn correct_bonds<H: Attributes>(
     bonds: &mut BondList<H>,

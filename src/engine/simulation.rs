@@ -223,7 +223,7 @@ impl<M: Model> Simulation<M> {
 }
 
 /// Σ_j V_j C_ij for each particle and DOF, C_ij the bond stiffness of [`Model::bond_stiffness`]:
-/// V_i times it bounds the particle's diagonal stiffness (THEORY.md §4, §5).
+/// V_i times it bounds the particle's diagonal stiffness (docs/theory.md §4, §5).
 pub fn stiffness_sums<M: Model>(
     model: &M,
     p: &Particles<M>,
@@ -247,7 +247,7 @@ pub fn stiffness_sums_of<M: Model>(
         let c = stiffness(&law, i, j, &bonds.geom[b]);
         let c = c.as_slice();
         // β ≤ 1 (partial volume) is left out, which errs on the safe side; a calibrated bar bond
-        // (bars.rs) or a surface-corrected one can be stiffer than its law, and counts.
+        // (input/bars.rs) or a surface-corrected one can be stiffer than its law, and counts.
         let beta = bonds.geom[b].beta.max(1.0);
         for (k, v) in sum[i].as_mut_slice().iter_mut().enumerate() {
             *v += p.volume[j] * c[k] * beta;
@@ -259,7 +259,7 @@ pub fn stiffness_sums_of<M: Model>(
     sum
 }
 
-/// The stable time step and the particle that sets it (THEORY.md §4): for each second-order
+/// The stable time step and the particle that sets it (docs/theory.md §4): for each second-order
 /// DOF the Silling–Askari bound √(2m / (V_i Σ_j V_j C_ij)), for each first-order DOF the
 /// forward-Euler bound C / (V_i Σ_j V_j K_ij) (Gershgorin: twice the diagonal bounds the
 /// largest eigenvalue). Infinite if no particle has a bond.

@@ -1,4 +1,4 @@
-//! Bars as one-dimensional members (THEORY.md §8): each bar's own bonds are scaled so that the
+//! Bars as one-dimensional members (docs/theory.md §8): each bar's own bonds are scaled so that the
 //! bar carries E·A·ε under a uniform stretch ε, and a bar may be prestrained.
 //!
 //! A line of particles of volume A·ds bonded with a 3D micromodulus c carries an axial force

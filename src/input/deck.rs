@@ -111,7 +111,7 @@ struct ModelSection {
     /// Horizon as a multiple of the lattice spacing.
     m: Option<f64>,
     partial_volume: Option<bool>,
-    /// "none" (default) or "energy" (THEORY.md §6).
+    /// "none" (default) or "energy" (docs/theory.md §6).
     surface_correction: Option<String>,
     #[serde(default)]
     options: BTreeMap<String, OptionSpec>,
@@ -336,7 +336,7 @@ pub struct ParallelSpec {
 /// How the critical time step of an explicit run is found (`[time] critical_step`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CriticalStep {
-    /// The Silling–Askari bound, per particle from its bonds (THEORY.md §4).
+    /// The Silling–Askari bound, per particle from its bonds (docs/theory.md §4).
     Bound,
     /// 2/√λ_max(M⁻¹K), the limit of central differences, with λ_max measured by a Lanczos run
     /// at setup (`spectrum::critical_time_step`).
@@ -422,7 +422,7 @@ pub enum SolverSpec {
     /// Explicit time integration (`[time]` integrator).
     Explicit,
     /// Adaptive dynamic relaxation to equilibrium at each of `load_steps` equal steps of the
-    /// loads' time history (THEORY.md §5).
+    /// loads' time history (docs/theory.md §5).
     Relaxation {
         load_steps: u64,
         /// Converged when |residual force| ≤ tolerance × |applied force and reactions|.
@@ -489,7 +489,7 @@ pub struct Scene {
     pub op_lines: Vec<usize>,
     pub bars: Vec<Bar>,
     pub bar_lines: Vec<usize>,
-    /// Initial stretch of each bar's own bonds (zero strain: none); see `bars.rs`.
+    /// Initial stretch of each bar's own bonds (zero strain: none); see `input/bars.rs`.
     pub bar_prestrain: Vec<Prestrain>,
     pub time: TimeSpec,
     pub boundaries: Vec<BoundarySpec>,

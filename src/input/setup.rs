@@ -466,7 +466,7 @@ fn static_start_allowed<M: Model>(scene: &Scene, until: f64) -> Result<(), DeckE
 }
 
 /// The bars' calibration factors (bond-based models) and prestrained bond histories; see
-/// `bars.rs`. `bar_of` is by global id.
+/// `input/bars.rs`. `bar_of` is by global id.
 fn bar_bonds<M: Model>(
     model: &M,
     particles: &mut Particles<M>,

@@ -109,7 +109,7 @@ history_every = {steps}
 "#,
         o = -0.5 * h,
         top = (n as f64 - 2.5) * h,
-        // Rotations bound micropolar's step below the peer's 1e-7 s (THEORY.md §4).
+        // Rotations bound micropolar's step below the peer's 1e-7 s (docs/theory.md §4).
         dt = if model == "micropolar" { 5e-8 } else { 1e-7 },
     ))
 }

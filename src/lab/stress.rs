@@ -2,7 +2,7 @@
 //!
 //! * **Critical time step**: the largest stable Δt of velocity Verlet (and forward Euler for
 //!   temperature), found by bisection on blow-up over a fixed number of steps, against the
-//!   Silling–Askari bound PDQ uses (THEORY.md §4), on a regular lattice, a jittered lattice and
+//!   Silling–Askari bound PDQ uses (docs/theory.md §4), on a regular lattice, a jittered lattice and
 //!   a steel–concrete mix. Every particle starts with a random velocity (and rotation rate,
 //!   temperature), so every mode of the lattice, the fastest included, is excited.
 //! * **Energy drift** over a long elastic vibration at the default safety factor.

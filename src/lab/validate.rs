@@ -1,7 +1,7 @@
 //! `pdq validate`: cases that compare PDQ with engineering formulas and report the error.
 //!
 //! A case is a deck (made here, at a coarse `--quick` or a fine `--full` resolution), a
-//! reference value from a formula (THEORY.md §7), a tolerance, and an extractor that reads the
+//! reference value from a formula (docs/theory.md §7), a tolerance, and an extractor that reads the
 //! measured value from the run's output. The runner writes `report.md` with the table (case,
 //! quantity, PDQ, reference, error, particles, run time) and a PNG plot per case.
 
@@ -530,7 +530,7 @@ fn axis_deflection(dir: &Path) -> Result<Vec<(f64, f64)>, String> {
     Ok(line)
 }
 
-/// The thesis's concrete beams (problems 4.1–4.4, THEORY.md §8): its concrete (E = 3605 ksi,
+/// The thesis's concrete beams (problems 4.1–4.4, docs/theory.md §8): its concrete (E = 3605 ksi,
 /// ν = ¼, s_t = 1.387e-4, s_c = −1.1e-3, f'c = 4000 psi), 200 or 250 × 30 × 50 in, on the
 /// thesis's 1 in lattice (`--full`) or a 2.5 in one (`--quick`), m = 3, the energy surface
 /// correction; the reinforced ones (4.2, 4.4) with three steel bars along the tension face. As
@@ -575,7 +575,7 @@ const COLLAPSE_DEFLECTION: f64 = 10.0;
 const RC_PEAK: f64 = 2.0;
 const RC_RAMP: f64 = 0.6;
 
-/// The thesis's concrete (THEORY.md §8) as a deck's `[materials.concrete]` table.
+/// The thesis's concrete (docs/theory.md §8) as a deck's `[materials.concrete]` table.
 fn thesis_concrete() -> String {
     format!(
         r#"[materials.concrete]

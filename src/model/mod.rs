@@ -209,7 +209,7 @@ pub fn check_options(
 pub struct BondGeom {
     /// |ξ|, the reference bond length.
     pub length: f64,
-    /// Partial-volume factor β ∈ (0, 1] scaling the partner volume (THEORY.md §6).
+    /// Partial-volume factor β ∈ (0, 1] scaling the partner volume (docs/theory.md §6).
     pub beta: f64,
 }
 
@@ -314,13 +314,13 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     /// The law of a bond between materials `mi` and `mj`.
     fn law(&self, mi: u16, mj: u16) -> Self::Law;
 
-    /// Stiffness of a bond for each degree of freedom, for the stable time step (THEORY.md §4):
+    /// Stiffness of a bond for each degree of freedom, for the stable time step (docs/theory.md §4):
     /// C_ij = c/|ξ| for translations (Silling–Askari), the moment per unit rotation for
     /// rotations, the conductance per unit temperature difference for first-order DOFs; all
     /// per unit volume of both ends.
     fn bond_stiffness(&self, law: &Self::Law, geom: &BondGeom) -> Self::Force;
 
-    /// The shape of adaptive dynamic relaxation's fictitious mass (`src/relaxation.rs`): a
+    /// The shape of adaptive dynamic relaxation's fictitious mass (`src/solve/adr.rs`): a
     /// bond's share of its ends' tangent stiffness, per DOF, in the units of
     /// [`Model::bond_stiffness`], which it defaults to. Only its distribution over the
     /// particles matters (the scale is measured); a state-based model whose stiffness depends
@@ -434,7 +434,7 @@ pub fn second_order<M: Model>() -> usize {
 }
 
 /// Lamé constants (λ, μ) of a bond-based solid of micromodulus `c` and horizon `delta`:
-/// K = πδ⁴c/18 and ν = 1/4, so λ = μ = 3K/5 (THEORY.md §1).
+/// K = πδ⁴c/18 and ν = 1/4, so λ = μ = 3K/5 (docs/theory.md §1).
 pub fn bond_based_lame(c: f64, delta: f64) -> (f64, f64) {
     let k = std::f64::consts::PI * delta.powi(4) * c / 18.0;
     (0.6 * k, 0.6 * k)

@@ -1,4 +1,4 @@
-//! Adaptive dynamic relaxation (Kilic & Madenci 2010; THEORY.md §5): quasi-static equilibrium
+//! Adaptive dynamic relaxation (Kilic & Madenci 2010; docs/theory.md §5): quasi-static equilibrium
 //! under the deck's loads and supports, one load step at a time, for every model with
 //! second-order degrees of freedom.
 //!

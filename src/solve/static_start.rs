@@ -1,7 +1,7 @@
 //! The static start of an explicit run (`[time] static_until`): instead of stepping through
 //! the slow, quasi-static beginning of a load history (a beam loaded through its elastic
 //! range before it cracks), the run reaches `static_until` by one implicit static solve —
-//! supports and loads at their values there, Newton's method to equilibrium (`implicit.rs`) —
+//! supports and loads at their values there, Newton's method to equilibrium (`solve/implicit.rs`) —
 //! and steps explicitly from that state, at rest. The skipped steps would have ended near the
 //! same state only if the loading were slow against the structure's periods; the static start
 //! is that limit, without the vibration a dynamic ramp leaves.

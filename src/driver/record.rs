@@ -1,0 +1,449 @@
+//! What a run records: the history row (named columns), the frame gathered on the root, and
+//! the final state by global id.
+
+use super::run::Summary;
+use super::step_loop::Plan;
+use crate::engine::particles::Particles;
+use crate::engine::timing::Phase;
+use crate::input::deck::SolverSpec;
+use crate::input::setup::Setup;
+use crate::model::attributes::Attributes;
+use crate::model::Model;
+use crate::output::History;
+use crate::parallel::comm::{f64s, Reduce};
+use crate::parallel::Cube;
+use std::fmt::Write as _;
+
+/// The names of the history columns, in the order of [`Row::values`].
+pub(crate) fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
+    let mut c: Vec<String> = [
+        "step",
+        "time",
+        "kinetic_energy",
+        "strain_energy",
+        "total_energy",
+        "broken_bonds",
+        "max_damage",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for l in &setup.sim.loads {
+        c.push(format!("load_{}", l.name));
+    }
+    for b in &setup.sim.constraints {
+        for &d in &b.dofs {
+            c.push(format!("reaction_{}_{}", b.name, dof_name::<M>(d)));
+        }
+    }
+    for (name, _) in &setup.probes {
+        for k in ["ux", "uy", "uz"] {
+            c.push(format!("{name}_{k}"));
+        }
+    }
+    c.push("residual_force".into());
+    if let SolverSpec::Relaxation { .. } = setup.solver {
+        c.push("iterations".into());
+        c.push("residual".into());
+    }
+    c
+}
+
+/// x, y, z for translations, else the model's name of the generalized force (`moment_x`,
+/// `heat`).
+fn dof_name<M: Model>(d: usize) -> String {
+    if d < 3 {
+        return ["x", "y", "z"][d].into();
+    }
+    let mut offset = 0;
+    for f in <M::Force as Attributes>::FIELDS {
+        if d < offset + f.len {
+            return match f.len {
+                1 => f.name.to_string(),
+                3 => format!("{}_{}", f.name, ["x", "y", "z"][d - offset]),
+                _ => format!("{}{}", f.name, d - offset),
+            };
+        }
+        offset += f.len;
+    }
+    format!("dof{d}")
+}
+
+/// One row of `history.csv`, by name; [`Row::values`] lays it out in the order of
+/// [`columns`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct Row {
+    pub step: u64,
+    pub time: f64,
+    pub kinetic_energy: f64,
+    pub strain_energy: f64,
+    pub broken_bonds: u64,
+    pub max_damage: f64,
+    /// Each load's total along its direction, in deck order.
+    pub loads: Vec<f64>,
+    /// Each constraint's reaction on each of its DOFs, in deck order.
+    pub reactions: Vec<f64>,
+    /// Each probe's displacement, in deck order.
+    pub probes: Vec<[f64; 3]>,
+    /// √(Σ F²) over the free second-order DOFs: how far from equilibrium.
+    pub residual_force: f64,
+    /// Under a quasi-static solver: the last load step's iterations and relative residual.
+    pub solve: Option<(u64, f64)>,
+}
+
+impl Row {
+    /// The CSV values, in column order.
+    pub fn values(&self) -> Vec<f64> {
+        let mut v = vec![
+            self.step as f64,
+            self.time,
+            self.kinetic_energy,
+            self.strain_energy,
+            self.kinetic_energy + self.strain_energy,
+            self.broken_bonds as f64,
+            self.max_damage,
+        ];
+        v.extend_from_slice(&self.loads);
+        v.extend_from_slice(&self.reactions);
+        v.extend(self.probes.iter().flatten());
+        v.push(self.residual_force);
+        if let Some((iterations, residual)) = self.solve {
+            v.push(iterations as f64);
+            v.push(residual);
+        }
+        v
+    }
+
+    /// One procCube's share of the row, reduced over all procCubes in one reduction (every
+    /// worker must call it, and every worker gets the whole row).
+    pub fn reduced<M: Model>(cube: &mut Cube<M>, damage: &[f64], n_probes: usize) -> Row {
+        let sim = &cube.sim;
+        let (ke, se) = (sim.kinetic_energy(), sim.strain_energy());
+        let mut sums = vec![ke, se, cube.broken_count() as f64];
+        let n_loads = sim.loads.len();
+        for l in &sim.loads {
+            let t = l.total(sim.time);
+            let norm = (l.vector[0].powi(2) + l.vector[1].powi(2) + l.vector[2].powi(2)).sqrt();
+            let along = if norm > 0.0 {
+                (t[0] * l.vector[0] + t[1] * l.vector[1] + t[2] * l.vector[2]) / norm
+            } else {
+                0.0
+            };
+            sums.push(along);
+        }
+        for b in &sim.constraints {
+            sums.extend_from_slice(&b.reaction);
+        }
+        let first_probe = sums.len();
+        sums.resize(first_probe + 3 * n_probes, 0.0);
+        for &(k, i) in &cube.probes {
+            sums[first_probe + 3 * k..first_probe + 3 * k + 3]
+                .copy_from_slice(&sim.particles.displacement(i));
+        }
+        // Σ F² over the free second-order DOFs (supported ones hold 0).
+        let n2 = crate::model::second_order::<M>();
+        let p = &sim.particles;
+        sums.push(
+            (0..p.n_owned)
+                .flat_map(|i| p.force[i].as_slice()[..n2].iter())
+                .map(|f| f * f)
+                .sum(),
+        );
+        let (step, time) = (sim.step, sim.time);
+        let mut team = cube.team();
+        team.reduce(&mut sums, Reduce::Sum);
+        let max_damage = team.max(damage.iter().cloned().fold(0.0, f64::max));
+        let probes = sums[first_probe..first_probe + 3 * n_probes]
+            .chunks_exact(3)
+            .map(|u| [u[0], u[1], u[2]])
+            .collect();
+        Row {
+            step,
+            time,
+            kinetic_energy: sums[0],
+            strain_energy: sums[1],
+            broken_bonds: sums[2] as u64,
+            max_damage,
+            loads: sums[3..3 + n_loads].to_vec(),
+            reactions: sums[3 + n_loads..first_probe].to_vec(),
+            probes,
+            residual_force: sums[first_probe + 3 * n_probes].sqrt(),
+            solve: None,
+        }
+    }
+}
+
+/// Owned particles' global indices, damage and every declared record (alterable, fixed, state,
+/// force), gathered on the root.
+pub(crate) fn gather_frame<M: Model>(
+    cube: &mut Cube<M>,
+    damage: &[f64],
+    store: &mut Option<FrameStore<M>>,
+) {
+    // Reference positions travel too: a shuffle moves them with particles it wraps around a
+    // periodic box.
+    let lens = [
+        <M::Alter as Attributes>::LEN,
+        <M::Fixed as Attributes>::LEN,
+        <M::State as Attributes>::LEN,
+        <M::Force as Attributes>::LEN,
+    ];
+    let record = 5 + lens.iter().sum::<usize>();
+    let p = &cube.sim.particles;
+    let n = p.n_owned;
+    let mut mine = Vec::with_capacity(n * record);
+    for (i, &d) in damage.iter().enumerate().take(n) {
+        mine.push(p.gid[i] as f64);
+        mine.push(d);
+        mine.extend_from_slice(&p.x0[i]);
+        mine.extend_from_slice(p.alter[i].as_slice());
+        mine.extend_from_slice(p.fixed[i].as_slice());
+        mine.extend_from_slice(p.state[i].as_slice());
+        mine.extend_from_slice(p.force[i].as_slice());
+    }
+    let all = cube.team().gather(bytemuck::cast_slice(&mine));
+    if let (Some(all), Some(store)) = (all, store.as_mut()) {
+        for bytes in all {
+            for rec in f64s(&bytes).chunks_exact(record) {
+                let g = store.index_of[rec[0] as usize] as usize;
+                store.damage[g] = rec[1];
+                store.particles.x0[g] = [rec[2], rec[3], rec[4]];
+                let sp = &mut store.particles;
+                let targets = [
+                    sp.alter[g].as_mut_slice(),
+                    sp.fixed[g].as_mut_slice(),
+                    sp.state[g].as_mut_slice(),
+                    sp.force[g].as_mut_slice(),
+                ];
+                let mut at = 5;
+                for (t, len) in targets.into_iter().zip(lens) {
+                    t.copy_from_slice(&rec[at..at + len]);
+                    at += len;
+                }
+            }
+        }
+    }
+}
+
+/// The whole scene on the root, refreshed from all procCubes for each frame.
+pub(crate) struct FrameStore<M: Model> {
+    pub particles: Particles<M>,
+    pub damage: Vec<f64>,
+    /// Store index of each global id.
+    pub index_of: Vec<u32>,
+}
+
+pub(crate) fn frame_store<M: Model>(setup: Setup<M>) -> FrameStore<M> {
+    let n = setup.sim.particles.len();
+    let mut index_of = vec![0u32; n];
+    for (i, &g) in setup.sim.particles.gid.iter().enumerate() {
+        index_of[g as usize] = i as u32;
+    }
+    FrameStore {
+        particles: setup.sim.particles,
+        damage: vec![0.0; n],
+        index_of,
+    }
+}
+
+/// Final positions by global id and the broken bonds, at full precision, for comparing runs.
+pub(crate) fn write_final_state(
+    dir: &std::path::Path,
+    position: &[[f64; 3]],
+    damage: &[f64],
+    broken: &[(u32, u32)],
+) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("final_positions.csv"))?);
+    writeln!(f, "id,x,y,z,damage")?;
+    for (g, (p, d)) in position.iter().zip(damage).enumerate() {
+        writeln!(
+            f,
+            "{g},{:.17e},{:.17e},{:.17e},{:.17e}",
+            p[0], p[1], p[2], d
+        )?;
+    }
+    f.flush()?;
+    let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("broken_bonds.csv"))?);
+    writeln!(f, "id_a,id_b")?;
+    for (a, b) in broken {
+        writeln!(f, "{a},{b}")?;
+    }
+    f.flush()
+}
+
+/// Particles and time per procCube, max/mean, and the share of time spent communicating.
+pub(crate) fn balance_table(rows: &[Vec<f64>], steps: u64) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<9} {:>10} {:>8} {:>10} {:>10} {:>10} {:>12}",
+        "procCube", "particles", "ghosts", "forces s", "comm s", "step s", "bytes/step"
+    );
+    for (k, r) in rows.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "{:<9} {:>10} {:>8} {:>10.3} {:>10.3} {:>10.3} {:>12.0}",
+            k,
+            r[0],
+            r[1],
+            r[2],
+            r[3],
+            r[4],
+            r[5] / steps.max(1) as f64
+        );
+    }
+    let col = |c: usize| -> (f64, f64) {
+        let max = rows.iter().map(|r| r[c]).fold(0.0, f64::max);
+        let mean = rows.iter().map(|r| r[c]).sum::<f64>() / rows.len() as f64;
+        (max, mean)
+    };
+    let (pmax, pmean) = col(0);
+    let (fmax, fmean) = col(2);
+    let (cmax, _) = col(3);
+    let (smax, _) = col(4);
+    let _ = writeln!(
+        s,
+        "load balance: particles max/mean {:.3}, force time max/mean {:.3}; communication {:.1}% of the slowest step loop",
+        pmax / pmean.max(1e-300),
+        fmax / fmean.max(1e-300),
+        100.0 * cmax / smax.max(1e-300)
+    );
+    s
+}
+
+/// The end of a run on every worker: totals reduced, the final positions, damage and broken
+/// bonds gathered by global id, each procCube's share of the time; the root completes
+/// `summary` with them, writes `timing.txt` (and the final state if asked) and returns it.
+pub(crate) fn finish<M: Model>(
+    mut cube: Cube<M>,
+    plan: &Plan,
+    mut history: Option<History>,
+    mut summary: Summary,
+) -> Result<Option<Summary>, String> {
+    let io = |e: std::io::Error| format!("writing output in {}: {e}", plan.dir.display());
+    let n_global = cube.global_particles;
+    let mut totals = [
+        (cube.sim.bonds.len() + cube.dropped.len()) as f64,
+        cube.broken_count() as f64,
+        cube.sim.kinetic_energy(),
+        cube.sim.strain_energy(),
+    ];
+    cube.team().reduce(&mut totals, Reduce::Sum);
+    let (position, damage) = final_positions(&mut cube, n_global);
+    let broken_pairs = final_broken_pairs(&mut cube);
+    let balance = balance_rows(&mut cube);
+    let Some(balance) = balance else {
+        return Ok(None);
+    };
+    let steps = cube.sim.step - plan.first_step;
+    let mut timing = cube.sim.timing.table(n_global as f64 * steps as f64);
+    let _ = writeln!(
+        timing,
+        "bonds: {} ({} broken); {}{}",
+        totals[0] as usize,
+        totals[1] as usize,
+        plan.layout,
+        if summary.shuffles > 0 {
+            format!(", {} shuffles moved particles", summary.shuffles)
+        } else {
+            String::new()
+        }
+    );
+    if balance.len() > 1 {
+        timing.push_str(&balance_table(&balance, steps));
+    }
+    if let Some(h) = history.as_mut() {
+        h.flush().map_err(io)?;
+    }
+    std::fs::write(plan.dir.join("timing.txt"), &timing).map_err(io)?;
+    if plan.final_state {
+        write_final_state(&plan.dir, &position, &damage, &broken_pairs).map_err(io)?;
+    }
+    if let Some((_, size, secs)) = summary.checkpoints.last() {
+        let _ = writeln!(
+            timing,
+            "checkpoints: {} written, the last {:.1} MB in {:.3} s",
+            summary.checkpoints.len(),
+            *size as f64 / 1e6,
+            secs
+        );
+    }
+    summary.particles = n_global;
+    summary.bonds = totals[0] as usize;
+    summary.steps = cube.sim.step;
+    summary.dt = cube.sim.dt;
+    summary.broken = totals[1] as usize;
+    summary.kinetic_energy = totals[2];
+    summary.strain_energy = totals[3];
+    summary.timing = timing;
+    summary.positions = position;
+    summary.damage = damage;
+    summary.broken_pairs = broken_pairs;
+    Ok(Some(summary))
+}
+
+/// Current positions and damage by global id, on the root (empty elsewhere).
+fn final_positions<M: Model>(cube: &mut Cube<M>, n_global: usize) -> (Vec<[f64; 3]>, Vec<f64>) {
+    let damage = cube.damage();
+    let mut mine: Vec<f64> = Vec::new();
+    for (i, d) in damage.iter().enumerate() {
+        mine.push(cube.sim.particles.gid[i] as f64);
+        mine.extend_from_slice(&cube.sim.particles.pos(i));
+        mine.push(*d);
+    }
+    let Some(parts) = cube.team().gather(bytemuck::cast_slice(&mine)) else {
+        return (Vec::new(), Vec::new());
+    };
+    let mut position = vec![[f64::NAN; 3]; n_global];
+    let mut damage_by_id = vec![f64::NAN; n_global];
+    for bytes in parts {
+        for rec in f64s(&bytes).chunks_exact(5) {
+            position[rec[0] as usize] = [rec[1], rec[2], rec[3]];
+            damage_by_id[rec[0] as usize] = rec[4];
+        }
+    }
+    (position, damage_by_id)
+}
+
+/// The broken bonds as sorted (smaller, larger) global id pairs, on the root.
+fn final_broken_pairs<M: Model>(cube: &mut Cube<M>) -> Vec<(u32, u32)> {
+    let pairs: Vec<f64> = cube
+        .broken_pairs()
+        .iter()
+        .flat_map(|&(a, b)| [a as f64, b as f64])
+        .collect();
+    let mut all: Vec<(u32, u32)> = cube
+        .team()
+        .gather(bytemuck::cast_slice(&pairs))
+        .unwrap_or_default()
+        .iter()
+        .flat_map(|b| {
+            f64s(b)
+                .chunks_exact(2)
+                .map(|c| (c[0] as u32, c[1] as u32))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    all.sort_unstable();
+    all
+}
+
+/// Each procCube's particles, ghosts, force, communication and step-loop seconds and bytes
+/// sent, on the root (`None` elsewhere).
+fn balance_rows<M: Model>(cube: &mut Cube<M>) -> Option<Vec<Vec<f64>>> {
+    let traffic = cube.wall.traffic;
+    let tm = &cube.sim.timing;
+    let balance = [
+        cube.sim.particles.n_owned as f64,
+        cube.plan.ghosts() as f64,
+        tm.get(Phase::Forces).as_secs_f64() + tm.get(Phase::State).as_secs_f64(),
+        tm.get(Phase::Communication).as_secs_f64(),
+        tm.total().as_secs_f64()
+            - tm.get(Phase::Setup).as_secs_f64()
+            - tm.get(Phase::Output).as_secs_f64(),
+        traffic.bytes as f64,
+    ];
+    let all = cube.team().gather(bytemuck::cast_slice(&balance))?;
+    Some(all.iter().map(|b| f64s(b)).collect())
+}
