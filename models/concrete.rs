@@ -12,7 +12,8 @@
 //! limits.
 
 use crate::model::{
-    bond_based_lame, check_options, stretch, BondGeom, MaterialKind, Model, ModelBuild, Side,
+    bond_based_lame, check_options, stretch, BondGeom, Dimension, Material, MaterialKind, Model,
+    ModelBuild, ModelError, PairTable, Side,
 };
 use std::f64::consts::PI;
 
@@ -46,8 +47,7 @@ impl Law {
 
 #[derive(Clone, Debug)]
 pub struct Concrete {
-    laws: Vec<Law>,
-    n: usize,
+    laws: PairTable<Law>,
     density: Vec<f64>,
     delta: f64,
 }
@@ -107,96 +107,26 @@ impl Model for Concrete {
     type Force = Force3;
     type Law = Law;
 
-    fn build(b: &ModelBuild) -> Result<Self, String> {
+    fn build(b: &ModelBuild) -> Result<Self, ModelError> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
         let factor = b.option("interface_factor")?.unwrap_or(3.0);
         if !(factor.is_finite() && factor > 0.0) {
             return Err("model option 'interface_factor' must be > 0".into());
         }
-        let mut own = Vec::new();
-        for m in b.materials {
-            let used: &[&str] = match m.kind {
-                MaterialKind::Steel => &[
-                    "youngs_modulus",
-                    "poisson_ratio",
-                    "yield_stretch",
-                    "failure_stretch",
-                ],
-                _ => &[
-                    "youngs_modulus",
-                    "poisson_ratio",
-                    "tensile_stretch",
-                    "compressive_stretch",
-                ],
-            };
-            m.only_uses(used, Self::NAME)?;
-            let e = m.require(m.youngs_modulus, "youngs_modulus", Self::NAME)?;
-            let nu = m.require(m.poisson_ratio, "poisson_ratio", Self::NAME)?;
-            if !(nu > -1.0 && nu < 0.5) {
-                return Err(format!(
-                    "material '{}': poisson_ratio must lie in (-1, 0.5), got {nu}",
-                    m.name
-                ));
-            }
-            let c = thesis_micromodulus(e, nu, b.horizon);
-            let law = match m.kind {
-                MaterialKind::Concrete => {
-                    let tensile = m.require(m.tensile_stretch, "tensile_stretch", Self::NAME)?;
-                    let compressive =
-                        m.require(m.compressive_stretch, "compressive_stretch", Self::NAME)?;
-                    if !(tensile > 0.0 && compressive < 0.0) {
-                        return Err(format!(
-                            "material '{}': need tensile_stretch > 0 and compressive_stretch < 0",
-                            m.name
-                        ));
-                    }
-                    Law::Brittle {
-                        c,
-                        tensile,
-                        compressive,
-                    }
-                }
-                MaterialKind::Steel => {
-                    let yield_ = m.require(m.yield_stretch, "yield_stretch", Self::NAME)?;
-                    let failure = m.failure_stretch.unwrap_or(f64::INFINITY);
-                    if !(yield_ > 0.0 && failure > yield_) {
-                        return Err(format!(
-                            "material '{}': need 0 < yield_stretch < failure_stretch",
-                            m.name
-                        ));
-                    }
-                    Law::Plastic {
-                        c,
-                        yield_,
-                        failure,
-                    }
-                }
-                MaterialKind::Solid => {
-                    return Err(format!(
-                        "material '{}' has kind 'solid'; model 'concrete' takes kind = \"concrete\" or \"steel\"",
-                        m.name
-                    ))
-                }
-            };
-            own.push(law);
-        }
-        let n = own.len();
-        let mut laws = Vec::with_capacity(n * n);
-        for a in &own {
-            for b in &own {
-                laws.push(combine(*a, *b, factor));
-            }
-        }
+        let own = b
+            .materials
+            .iter()
+            .map(|m| own_law(m, b.horizon))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Concrete {
-            laws,
-            n,
+            laws: PairTable::new(&own, |a, b| combine(*a, *b, factor)),
             delta: b.horizon,
             density: b.materials.iter().map(|m| m.density).collect(),
         })
     }
 
     fn breaks(&self) -> bool {
-        self.laws.iter().any(|l| match *l {
+        self.laws.all().iter().any(|l| match *l {
             Law::Brittle {
                 tensile,
                 compressive,
@@ -212,7 +142,7 @@ impl Model for Concrete {
     }
 
     fn law(&self, mi: u16, mj: u16) -> Law {
-        self.laws[mi as usize * self.n + mj as usize]
+        self.laws.get(mi, mj)
     }
 
     fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> Force3 {
@@ -278,6 +208,73 @@ impl Model for Concrete {
         let c = law.stiffness();
         0.5 * c * elastic * elastic * geom.length * geom.beta * i.volume * j.volume
     }
+}
+
+/// The law of one material: brittle concrete between its compressive and tensile stretches,
+/// or elastic–plastic steel up to its failure stretch.
+fn own_law(m: &Material, delta: f64) -> Result<Law, ModelError> {
+    let name = Concrete::NAME;
+    let used: &[&str] = match m.kind {
+        MaterialKind::Steel => &[
+            "youngs_modulus",
+            "poisson_ratio",
+            "yield_stretch",
+            "failure_stretch",
+        ],
+        _ => &[
+            "youngs_modulus",
+            "poisson_ratio",
+            "tensile_stretch",
+            "compressive_stretch",
+        ],
+    };
+    m.only_uses(used, name)?;
+    let e = m.require(
+        m.positive("youngs_modulus", Dimension::STRESS)?,
+        "youngs_modulus",
+        name,
+    )?;
+    let nu = m.require(m.poisson_ratio()?, "poisson_ratio", name)?;
+    let c = thesis_micromodulus(e, nu, delta);
+    let stretch = |key: &str| m.positive(key, Dimension::NUMBER);
+    Ok(match m.kind {
+        MaterialKind::Concrete => {
+            let tensile = m.require(stretch("tensile_stretch")?, "tensile_stretch", name)?;
+            let compressive = m.checked(
+                "compressive_stretch",
+                Dimension::NUMBER,
+                |c| c < 0.0,
+                "be < 0",
+            )?;
+            let compressive = m.require(compressive, "compressive_stretch", name)?;
+            Law::Brittle {
+                c,
+                tensile,
+                compressive,
+            }
+        }
+        MaterialKind::Steel => {
+            let yield_ = m.require(stretch("yield_stretch")?, "yield_stretch", name)?;
+            let failure = stretch("failure_stretch")?.unwrap_or(f64::INFINITY);
+            if failure <= yield_ {
+                return Err(m.error(format!(
+                    "material '{}': need 0 < yield_stretch < failure_stretch",
+                    m.name
+                )));
+            }
+            Law::Plastic {
+                c,
+                yield_,
+                failure,
+            }
+        }
+        MaterialKind::Solid => {
+            return Err(m.error(format!(
+                "material '{}' has kind 'solid'; model 'concrete' takes kind = \"concrete\" or \"steel\"",
+                m.name
+            )))
+        }
+    })
 }
 
 /// The law between two materials' own laws.

@@ -16,7 +16,9 @@
 //! "inverse_length" (ω = δ/L, LAMMPS's and Peridynamics.jl's), "gaussian"
 //! (ω = exp(−L²/(0.4δ)²)).
 
-use crate::model::{check_options, BondGeom, Model, ModelBuild, Side};
+use crate::model::{
+    check_options, BondGeom, Dimension, Material, Model, ModelBuild, ModelError, Side,
+};
 
 pub use super::pmb::{Force3, Motion};
 
@@ -123,49 +125,13 @@ impl Model for Lps {
     type Force = Force3;
     type Law = Law;
 
-    fn build(b: &ModelBuild) -> Result<Self, String> {
+    fn build(b: &ModelBuild) -> Result<Self, ModelError> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
         let influence = Influence::parse(b.word("influence")?)?;
         let delta = b.horizon;
         let (mut moduli, mut s0) = (Vec::new(), Vec::new());
         for m in b.materials {
-            m.only_uses(
-                &[
-                    "youngs_modulus",
-                    "bulk_modulus",
-                    "poisson_ratio",
-                    "critical_stretch",
-                    "fracture_energy",
-                ],
-                Self::NAME,
-            )?;
-            let nu = m.require(m.poisson_ratio, "poisson_ratio", Self::NAME)?;
-            let k = match (m.youngs_modulus, m.bulk_modulus) {
-                (Some(e), None) => e / (3.0 * (1.0 - 2.0 * nu)),
-                (None, Some(k)) => k,
-                _ => {
-                    return Err(format!(
-                        "material '{}' needs one of 'youngs_modulus' or 'bulk_modulus' (with 'poisson_ratio') for model 'lps'",
-                        m.name
-                    ))
-                }
-            };
-            let g = 3.0 * k * (1.0 - 2.0 * nu) / (2.0 * (1.0 + nu));
-            let s = m.critical_stretch_or(|g0| {
-                (g0 / ((3.0 * g + 0.75f64.powi(4) * (k - 5.0 * g / 3.0)) * delta)).sqrt()
-            })?;
-            if !(k.is_finite() && k > 0.0 && g > 0.0) {
-                return Err(format!(
-                    "material '{}': the moduli must be > 0 (K = {k:e}, G = {g:e})",
-                    m.name
-                ));
-            }
-            if s.is_nan() || s <= 0.0 {
-                return Err(format!(
-                    "material '{}': critical stretch must be > 0",
-                    m.name
-                ));
-            }
+            let (k, g, s) = own_constants(m, delta)?;
             moduli.push((k, g));
             s0.push(s);
         }
@@ -341,4 +307,49 @@ impl Model for Lps {
         let k = self.moduli[material as usize].0;
         0.5 * k * state.dilatation * state.dilatation * volume
     }
+}
+
+/// K, G and the critical stretch of one material: ν with E or K, s0 given or from G0.
+fn own_constants(m: &Material, delta: f64) -> Result<(f64, f64, f64), ModelError> {
+    m.only_uses(
+        &[
+            "youngs_modulus",
+            "bulk_modulus",
+            "poisson_ratio",
+            "critical_stretch",
+            "fracture_energy",
+        ],
+        Lps::NAME,
+    )?;
+    let nu = m.require(m.poisson_ratio()?, "poisson_ratio", Lps::NAME)?;
+    let (which, value) = m.one_of(
+        &[
+            ("youngs_modulus", Dimension::STRESS),
+            ("bulk_modulus", Dimension::STRESS),
+        ],
+        Lps::NAME,
+        "one of 'youngs_modulus' or 'bulk_modulus' (with 'poisson_ratio')",
+    )?;
+    let k = if which == 0 {
+        value / (3.0 * (1.0 - 2.0 * nu))
+    } else {
+        value
+    };
+    let g = 3.0 * k * (1.0 - 2.0 * nu) / (2.0 * (1.0 + nu));
+    let s = m.critical_stretch_or(|g0| {
+        (g0 / ((3.0 * g + 0.75f64.powi(4) * (k - 5.0 * g / 3.0)) * delta)).sqrt()
+    })?;
+    if !(k.is_finite() && k > 0.0 && g > 0.0) {
+        return Err(m.error(format!(
+            "material '{}': the moduli must be > 0 (K = {k:e}, G = {g:e})",
+            m.name
+        )));
+    }
+    if s.is_nan() || s <= 0.0 {
+        return Err(m.error(format!(
+            "material '{}': critical stretch must be > 0",
+            m.name
+        )));
+    }
+    Ok((k, g, s))
 }

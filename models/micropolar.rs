@@ -25,7 +25,10 @@
 
 use crate::model::attributes::Attributes;
 use crate::model::lanes::{LaneForces, Real, F4, LANES};
-use crate::model::{check_options, BondGeom, MaterialKind, Model, ModelBuild, Side};
+use crate::model::rotation::{matrix, product, quaternion, relative, rotation_vector};
+use crate::model::{
+    check_options, BondGeom, Dimension, Material, MaterialKind, Model, ModelBuild, ModelError, Side,
+};
 use std::f64::consts::PI;
 
 crate::attributes! {
@@ -78,86 +81,6 @@ pub struct Micropolar {
     kappa: f64,
     delta: f64,
     spacing: f64,
-}
-
-/// The rotation matrix (row major) of the unit quaternion q.
-fn matrix(q: &[f64; 4]) -> [f64; 9] {
-    let [w, x, y, z] = *q;
-    [
-        1.0 - 2.0 * (y * y + z * z),
-        2.0 * (x * y - w * z),
-        2.0 * (x * z + w * y),
-        2.0 * (x * y + w * z),
-        1.0 - 2.0 * (x * x + z * z),
-        2.0 * (y * z - w * x),
-        2.0 * (x * z - w * y),
-        2.0 * (y * z + w * x),
-        1.0 - 2.0 * (x * x + y * y),
-    ]
-}
-
-/// a ⊗ b.
-#[inline(always)]
-fn product<T: Real>(a: &[T; 4], b: &[T; 4]) -> [T; 4] {
-    [
-        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
-        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
-        a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
-        a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0],
-    ]
-}
-
-/// sin|φ| φ̂ and 1 − cos|φ| of the rotation φ taking orientation `qi` to `qj` (spatial frame):
-/// from q = q_j ⊗ q_i*, sin|φ| φ̂ = 2 q_w q_v and 1 − cos|φ| = 2|q_v|².
-#[inline(always)]
-fn relative<T: Real>(qi: &[T; 4], qj: &[T; 4]) -> ([T; 3], T) {
-    let q = product(qj, &[qi[0], -qi[1], -qi[2], -qi[3]]);
-    let two = T::splat(2.0);
-    (
-        [two * q[0] * q[1], two * q[0] * q[2], two * q[0] * q[3]],
-        two * (q[1] * q[1] + q[2] * q[2] + q[3] * q[3]),
-    )
-}
-
-/// The rotation vector of a unit quaternion.
-fn rotation_vector(q: &[f64; 4]) -> [f64; 3] {
-    let (w, v) = if q[0] < 0.0 {
-        (-q[0], [-q[1], -q[2], -q[3]])
-    } else {
-        (q[0], [q[1], q[2], q[3]])
-    };
-    let s2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-    // 2 atan2(s, w)/s = (2/w) atan(t)/t with t = s/w. Below t = 1/64 the series to t⁸ is exact
-    // to round-off (next term t¹⁰/11 < 1e-19) and avoids atan2 and a square root on every
-    // particle at every step; most rotations in a structure are that small.
-    let k = if s2 < (w * w) * (1.0 / 4096.0) {
-        let t2 = s2 / (w * w);
-        2.0 / w * (1.0 - t2 * (1.0 / 3.0 - t2 * (1.0 / 5.0 - t2 * (1.0 / 7.0 - t2 / 9.0))))
-    } else {
-        let s = s2.sqrt();
-        2.0 * s.atan2(w) / s
-    };
-    [k * v[0], k * v[1], k * v[2]]
-}
-
-/// The unit quaternion of rotation vector `r`.
-fn quaternion(r: [f64; 3]) -> [f64; 4] {
-    let a2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    // cos(a/2) and sin(a/2)/a. A step turns a particle by far less than 1/16 rad, where the
-    // series to a⁸ are exact to round-off (next terms below 1e-20 relative): no sin and cos on
-    // every particle at every step.
-    let (c, k) = if a2 < 1.0 / 256.0 {
-        let x = 0.25 * a2; // (a/2)²
-        (
-            1.0 - x * (0.5 - x * (1.0 / 24.0 - x * (1.0 / 720.0 - x / 40320.0))),
-            0.5 * (1.0 - x * (1.0 / 6.0 - x * (1.0 / 120.0 - x * (1.0 / 5040.0 - x / 362880.0)))),
-        )
-    } else {
-        let angle = a2.sqrt();
-        let half = 0.5 * angle;
-        (half.cos(), half.sin() / angle)
-    };
-    [c, k * r[0], k * r[1], k * r[2]]
 }
 
 /// A bond's strain measures, scaled by L to save divisions, for one bond (`T = f64`) or a lane
@@ -257,6 +180,58 @@ const POS: usize = std::mem::offset_of!(Motion6, pos) / 8;
 const ORIENTATION: usize = std::mem::offset_of!(Motion6, orientation) / 8;
 const FRAME: usize = std::mem::offset_of!(Motion6, frame) / 8;
 
+/// Normal and shear bond constants and critical stretches of one material, from E and ν.
+fn own_constants(m: &Material, delta: f64) -> Result<Own, ModelError> {
+    let name = Micropolar::NAME;
+    let concrete = m.kind == MaterialKind::Concrete;
+    let breaking: &[&str] = if concrete {
+        &["tensile_stretch", "compressive_stretch"]
+    } else {
+        &["critical_stretch", "fracture_energy"]
+    };
+    let mut used = vec!["youngs_modulus", "poisson_ratio"];
+    used.extend_from_slice(breaking);
+    m.only_uses(&used, name)?;
+    let e = m.require(
+        m.positive("youngs_modulus", Dimension::STRESS)?,
+        "youngs_modulus",
+        name,
+    )?;
+    let nu = m.require(m.poisson_ratio()?, "poisson_ratio", name)?;
+    if nu > 0.25 + 1e-12 {
+        return Err(m.error(format!(
+            "material '{}': micropolar bonds need poisson_ratio <= 1/4 (c_s >= 0), the deck gives {nu}; use model 'lps' for larger values",
+            m.name
+        )));
+    }
+    let d4 = PI * delta.powi(4);
+    let cn = 6.0 * e / (d4 * (1.0 - 2.0 * nu));
+    let cs = 6.0 * e * (1.0 - 4.0 * nu) / (d4 * (1.0 + nu) * (1.0 - 2.0 * nu));
+    let (tensile, compressive) = if concrete {
+        let tensile = m.positive("tensile_stretch", Dimension::NUMBER)?;
+        let compressive = m.checked(
+            "compressive_stretch",
+            Dimension::NUMBER,
+            |c| c < 0.0,
+            "be < 0",
+        )?;
+        (
+            m.require(tensile, "tensile_stretch", name)?,
+            m.require(compressive, "compressive_stretch", name)?,
+        )
+    } else {
+        let s0 =
+            m.critical_stretch_or(|g0| (5.0 * g0 * (1.0 - 2.0 * nu) / (3.0 * e * delta)).sqrt())?;
+        (s0, f64::NEG_INFINITY)
+    };
+    Ok(Own {
+        cn,
+        cs,
+        tensile,
+        compressive,
+    })
+}
+
 impl Model for Micropolar {
     const NAME: &'static str = "micropolar";
     const SUMMARY: &'static str =
@@ -277,55 +252,18 @@ impl Model for Micropolar {
     type Force = Force6;
     type Law = Law;
 
-    fn build(b: &ModelBuild) -> Result<Self, String> {
+    fn build(b: &ModelBuild) -> Result<Self, ModelError> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
         let kappa = b.option("kappa")?.unwrap_or(0.0);
         if !(kappa.is_finite() && kappa >= 0.0) {
-            return Err(format!(
-                "model 'micropolar': kappa must be >= 0 (got {kappa})"
-            ));
+            return Err(format!("model 'micropolar': kappa must be >= 0 (got {kappa})").into());
         }
         let delta = b.horizon;
-        let mut own = Vec::new();
-        for m in b.materials {
-            let concrete = m.kind == MaterialKind::Concrete;
-            let breaking: &[&str] = if concrete {
-                &["tensile_stretch", "compressive_stretch"]
-            } else {
-                &["critical_stretch", "fracture_energy"]
-            };
-            let mut used = vec!["youngs_modulus", "poisson_ratio"];
-            used.extend_from_slice(breaking);
-            m.only_uses(&used, Self::NAME)?;
-            let e = m.require(m.youngs_modulus, "youngs_modulus", Self::NAME)?;
-            let nu = m.require(m.poisson_ratio, "poisson_ratio", Self::NAME)?;
-            if nu > 0.25 + 1e-12 {
-                return Err(format!(
-                    "material '{}': micropolar bonds need poisson_ratio <= 1/4 (c_s >= 0), the deck gives {nu}; use model 'lps' for larger values",
-                    m.name
-                ));
-            }
-            let d4 = PI * delta.powi(4);
-            let cn = 6.0 * e / (d4 * (1.0 - 2.0 * nu));
-            let cs = 6.0 * e * (1.0 - 4.0 * nu) / (d4 * (1.0 + nu) * (1.0 - 2.0 * nu));
-            let (tensile, compressive) = if concrete {
-                (
-                    m.require(m.tensile_stretch, "tensile_stretch", Self::NAME)?,
-                    m.require(m.compressive_stretch, "compressive_stretch", Self::NAME)?,
-                )
-            } else {
-                let s0 = m.critical_stretch_or(|g0| {
-                    (5.0 * g0 * (1.0 - 2.0 * nu) / (3.0 * e * delta)).sqrt()
-                })?;
-                (s0, f64::NEG_INFINITY)
-            };
-            own.push(Own {
-                cn,
-                cs,
-                tensile,
-                compressive,
-            });
-        }
+        let own = b
+            .materials
+            .iter()
+            .map(|m| own_constants(m, delta))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Micropolar {
             own,
             density: b.materials.iter().map(|m| m.density).collect(),
@@ -542,7 +480,8 @@ impl Model for Micropolar {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Material, OptionValue};
+    use crate::model::material::PlainNumbers;
+    use crate::model::{Material, OptionValue, Written};
 
     fn model(kappa: f64, materials: &[Material]) -> Micropolar {
         let options = [("kappa".to_string(), OptionValue::Number(kappa))];
@@ -556,11 +495,16 @@ mod tests {
     }
 
     fn solid(name: &str, e: f64, nu: f64, s0: f64) -> Material {
-        let mut m = Material::new(name, MaterialKind::Solid, 2400.0);
-        m.youngs_modulus = Some(e);
-        m.poisson_ratio = Some(nu);
-        m.critical_stretch = Some(s0);
-        m
+        let keys = [
+            ("youngs_modulus", e),
+            ("poisson_ratio", nu),
+            ("critical_stretch", s0),
+        ];
+        let keys = keys
+            .iter()
+            .map(|&(k, v)| (k.to_string(), Written::Number(v)))
+            .collect();
+        Material::new(name, 0, MaterialKind::Solid, 2400.0, keys, &PlainNumbers).unwrap()
     }
 
     /// A particle moved and turned by a deterministic pseudo-random amount.

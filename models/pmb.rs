@@ -5,7 +5,10 @@
 //! docs/theory.md §1. A bond between two materials takes the series stiffness 2c_a c_b/(c_a + c_b)
 //! and the smaller critical stretch.
 
-use crate::model::{bond_based_lame, check_options, stretch, BondGeom, Model, ModelBuild, Side};
+use crate::model::{
+    bond_based_lame, check_options, stretch, BondGeom, Dimension, Material, Model, ModelBuild,
+    ModelError, PairTable, Side,
+};
 use std::f64::consts::PI;
 
 crate::attributes! {
@@ -27,16 +30,64 @@ pub struct Law {
 
 #[derive(Clone, Debug)]
 pub struct Pmb {
-    /// `laws[a * n + b]` for materials a, b.
-    laws: Vec<Law>,
-    n: usize,
+    laws: PairTable<Law>,
     density: Vec<f64>,
     delta: f64,
 }
 
 impl Pmb {
     pub fn laws(&self) -> &[Law] {
-        &self.laws
+        self.laws.all()
+    }
+
+    /// The law of one material: c from one stiffness (ν = ¼ is built into bond-based PMB:
+    /// K = 2E/3), s0 given or from the fracture energy.
+    fn own_law(m: &Material, delta: f64) -> Result<Law, ModelError> {
+        m.only_uses(
+            &[
+                "bulk_modulus",
+                "youngs_modulus",
+                "micromodulus",
+                "poisson_ratio",
+                "critical_stretch",
+                "fracture_energy",
+            ],
+            Self::NAME,
+        )?;
+        let (which, value) = m.one_of(
+            &[
+                ("bulk_modulus", Dimension::STRESS),
+                ("youngs_modulus", Dimension::STRESS),
+                ("micromodulus", Dimension::MICROMODULUS),
+            ],
+            Self::NAME,
+            "'bulk_modulus', 'youngs_modulus' or 'micromodulus'",
+        )?;
+        let c = match which {
+            0 => 18.0 * value / (PI * delta.powi(4)),
+            1 => 12.0 * value / (PI * delta.powi(4)),
+            _ => value,
+        };
+        if let Some(nu) = m.poisson_ratio()? {
+            if (nu - 0.25).abs() > 1e-9 {
+                return Err(m.error(format!(
+                    "material '{}': bond-based PMB has Poisson's ratio 1/4, the deck gives {nu}; remove 'poisson_ratio' (other values need a state-based model)",
+                    m.name
+                )));
+            }
+        }
+        if !(c.is_finite() && c > 0.0) {
+            return Err(m.error(format!("material '{}': micromodulus must be > 0", m.name)));
+        }
+        // s0 = sqrt(10 G0 / (π c δ⁵)), equal to sqrt(5G0/(9Kδ)) with c = 18K/(πδ⁴).
+        let s0 = m.critical_stretch_or(|g0| (10.0 * g0 / (PI * c * delta.powi(5))).sqrt())?;
+        if s0.is_nan() || s0 <= 0.0 {
+            return Err(m.error(format!(
+                "material '{}': critical stretch must be > 0",
+                m.name
+            )));
+        }
+        Ok(Law { c, s0 })
     }
 }
 
@@ -52,85 +103,27 @@ impl Model for Pmb {
     type Force = Force3;
     type Law = Law;
 
-    fn build(b: &ModelBuild) -> Result<Self, String> {
+    fn build(b: &ModelBuild) -> Result<Self, ModelError> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
-        let delta = b.horizon;
-        let mut own = Vec::new();
-        for m in b.materials {
-            m.only_uses(
-                &[
-                    "bulk_modulus",
-                    "youngs_modulus",
-                    "micromodulus",
-                    "poisson_ratio",
-                    "critical_stretch",
-                    "fracture_energy",
-                ],
-                Self::NAME,
-            )?;
-            let stiffnesses = [m.micromodulus, m.bulk_modulus, m.youngs_modulus]
-                .iter()
-                .filter(|v| v.is_some())
-                .count();
-            if stiffnesses > 1 {
-                return Err(format!(
-                    "material '{}': give one of 'bulk_modulus', 'youngs_modulus' or 'micromodulus' for model 'pmb', not several",
-                    m.name
-                ));
-            }
-            let c = match (m.micromodulus, m.bulk_modulus, m.youngs_modulus) {
-                (Some(c), _, _) => c,
-                (None, Some(k), _) => 18.0 * k / (PI * delta.powi(4)),
-                // ν = 1/4 is built into bond-based PMB: K = 2E/3.
-                (None, None, Some(e)) => 12.0 * e / (PI * delta.powi(4)),
-                _ => {
-                    return Err(format!(
-                        "material '{}' needs 'bulk_modulus', 'youngs_modulus' or 'micromodulus' for model 'pmb'",
-                        m.name
-                    ))
-                }
-            };
-            if let Some(nu) = m.poisson_ratio {
-                if (nu - 0.25).abs() > 1e-9 {
-                    return Err(format!(
-                        "material '{}': bond-based PMB has Poisson's ratio 1/4, the deck gives {nu}; remove 'poisson_ratio' (other values need a state-based model)",
-                        m.name
-                    ));
-                }
-            }
-            if !(c.is_finite() && c > 0.0) {
-                return Err(format!("material '{}': micromodulus must be > 0", m.name));
-            }
-            // s0 = sqrt(10 G0 / (π c δ⁵)), equal to sqrt(5G0/(9Kδ)) with c = 18K/(πδ⁴).
-            let s0 = m.critical_stretch_or(|g0| (10.0 * g0 / (PI * c * delta.powi(5))).sqrt())?;
-            if s0.is_nan() || s0 <= 0.0 {
-                return Err(format!(
-                    "material '{}': critical stretch must be > 0",
-                    m.name
-                ));
-            }
-            own.push(Law { c, s0 });
-        }
-        let n = own.len();
-        let mut laws = Vec::with_capacity(n * n);
-        for a in &own {
-            for b in &own {
-                laws.push(Law {
-                    c: 2.0 * a.c * b.c / (a.c + b.c),
-                    s0: a.s0.min(b.s0),
-                });
-            }
-        }
+        let own = b
+            .materials
+            .iter()
+            .map(|m| Self::own_law(m, b.horizon))
+            .collect::<Result<Vec<_>, _>>()?;
+        // A bond between two materials: the series stiffness and the smaller critical stretch.
+        let laws = PairTable::new(&own, |a, b| Law {
+            c: 2.0 * a.c * b.c / (a.c + b.c),
+            s0: a.s0.min(b.s0),
+        });
         Ok(Pmb {
             laws,
-            n,
             delta: b.horizon,
             density: b.materials.iter().map(|m| m.density).collect(),
         })
     }
 
     fn breaks(&self) -> bool {
-        self.laws.iter().any(|l| l.s0.is_finite())
+        self.laws.all().iter().any(|l| l.s0.is_finite())
     }
 
     fn inertia(&self, material: u16, volume: f64, _fixed: &()) -> Force3 {
@@ -139,7 +132,7 @@ impl Model for Pmb {
     }
 
     fn law(&self, mi: u16, mj: u16) -> Law {
-        self.laws[mi as usize * self.n + mj as usize]
+        self.laws.get(mi, mj)
     }
 
     fn bond_stiffness(&self, law: &Law, geom: &BondGeom) -> Force3 {

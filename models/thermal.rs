@@ -13,7 +13,10 @@
 //!   and T_ref the option `reference_temperature` (default 0).
 //! * A broken bond carries neither force nor heat: a crack insulates.
 
-use crate::model::{bond_based_lame, check_options, BondGeom, Model, ModelBuild, Side};
+use crate::model::{
+    bond_based_lame, check_options, BondGeom, Dimension, Material, Model, ModelBuild, ModelError,
+    Side,
+};
 use std::f64::consts::PI;
 
 crate::attributes! {
@@ -76,52 +79,21 @@ impl Model for Thermal {
     type Force = ForceHeat;
     type Law = Law;
 
-    fn build(b: &ModelBuild) -> Result<Self, String> {
+    fn build(b: &ModelBuild) -> Result<Self, ModelError> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
         let reference = b.option("reference_temperature")?.unwrap_or(0.0);
         let delta = b.horizon;
         let mut own = Vec::new();
+        let mut specific_heat = Vec::new();
         for m in b.materials {
-            m.only_uses(
-                &[
-                    "bulk_modulus",
-                    "youngs_modulus",
-                    "critical_stretch",
-                    "fracture_energy",
-                    "thermal_conductivity",
-                    "specific_heat",
-                    "thermal_expansion",
-                ],
-                Self::NAME,
-            )?;
-            let k_bulk = match (m.bulk_modulus, m.youngs_modulus) {
-                (Some(k), None) => k,
-                (None, Some(e)) => 2.0 * e / 3.0,
-                _ => {
-                    return Err(format!(
-                        "material '{}' needs one of 'bulk_modulus' or 'youngs_modulus' for model 'thermal'",
-                        m.name
-                    ))
-                }
-            };
-            let c = 18.0 * k_bulk / (PI * delta.powi(4));
-            let s0 = m.critical_stretch_or(|g0| (10.0 * g0 / (PI * c * delta.powi(5))).sqrt())?;
-            own.push(Own {
-                c,
-                s0,
-                k: m.require(m.thermal_conductivity, "thermal_conductivity", Self::NAME)?,
-                alpha: m.thermal_expansion.unwrap_or(0.0),
-            });
-            m.require(m.specific_heat, "specific_heat", Self::NAME)?;
+            let (o, heat) = own_constants(m, delta)?;
+            own.push(o);
+            specific_heat.push(heat);
         }
         Ok(Thermal {
             own,
             density: b.materials.iter().map(|m| m.density).collect(),
-            specific_heat: b
-                .materials
-                .iter()
-                .map(|m| m.specific_heat.unwrap_or(1.0))
-                .collect(),
+            specific_heat,
             reference,
             delta,
         })
@@ -223,4 +195,48 @@ impl Model for Thermal {
         let s = (r - l) / l - law.alpha * t;
         0.5 * law.c * s * s * l * geom.beta * i.volume * j.volume
     }
+}
+
+/// The bond constants and the specific heat of one material.
+fn own_constants(m: &Material, delta: f64) -> Result<(Own, f64), ModelError> {
+    let name = Thermal::NAME;
+    m.only_uses(
+        &[
+            "bulk_modulus",
+            "youngs_modulus",
+            "critical_stretch",
+            "fracture_energy",
+            "thermal_conductivity",
+            "specific_heat",
+            "thermal_expansion",
+        ],
+        name,
+    )?;
+    let (which, value) = m.one_of(
+        &[
+            ("bulk_modulus", Dimension::STRESS),
+            ("youngs_modulus", Dimension::STRESS),
+        ],
+        name,
+        "one of 'bulk_modulus' or 'youngs_modulus'",
+    )?;
+    // ν = 1/4 is built into the bond-based solid: K = 2E/3.
+    let k_bulk = if which == 0 { value } else { 2.0 * value / 3.0 };
+    let c = 18.0 * k_bulk / (PI * delta.powi(4));
+    let s0 = m.critical_stretch_or(|g0| (10.0 * g0 / (PI * c * delta.powi(5))).sqrt())?;
+    let conductivity = m.positive("thermal_conductivity", Dimension::NUMBER)?;
+    let expansion = m.checked(
+        "thermal_expansion",
+        Dimension::NUMBER,
+        |a| a.is_finite(),
+        "be finite",
+    )?;
+    let own = Own {
+        c,
+        s0,
+        k: m.require(conductivity, "thermal_conductivity", name)?,
+        alpha: expansion.unwrap_or(0.0),
+    };
+    let heat = m.positive("specific_heat", Dimension::NUMBER)?;
+    Ok((own, m.require(heat, "specific_heat", name)?))
 }

@@ -22,7 +22,8 @@ fn every_example_deck_parses() {
 fn thesis_cantilever_deck_is_in_inch_pound_units() {
     let scene = deck::load(Path::new("inputs/cantilever_2in.toml")).unwrap();
     let c = &scene.materials[0];
-    assert_eq!(c.youngs_modulus, Some(3.605e6));
+    let e = c.quantity("youngs_modulus", pdq::model::Dimension::STRESS);
+    assert_eq!(e, Ok(Some(3.605e6)));
     // 145 lb/ft³ as pound-mass: 145 / 1728 / 386.09 lbf·s²/in⁴.
     assert!((c.density / (145.0 / 1728.0 / 386.09) - 1.0).abs() < 1e-12);
     assert_eq!(scene.horizon, 6.0);

@@ -18,7 +18,7 @@
 //! in speed for a cross-section w spacings wide), and dispersion (wavelength 67δ in the free
 //! bars, 15δ in the periodic ones: −0.2 %).
 
-use pdq::engine::simulation::Simulation;
+use pdq::engine::simulation::{Exchange, Local, Simulation};
 use pdq::input::{deck, setup};
 use pdq::model::attributes::Attributes;
 use pdq::model::Model;
@@ -106,6 +106,7 @@ impl Wave {
 /// the half periods.
 fn modal_frequency<M: Model>(
     sim: &mut Simulation<M>,
+    exchange: &mut impl Exchange<M>,
     shape: &dyn Fn(f64) -> f64,
     steps: usize,
 ) -> (f64, f64) {
@@ -124,7 +125,7 @@ fn modal_frequency<M: Model>(
     let mut previous = amplitude(sim);
     let mut crossings = Vec::new();
     for step in 0..steps {
-        sim.advance();
+        sim.advance_with(exchange);
         let a = amplitude(sim);
         if (previous > 0.0) != (a > 0.0) {
             crossings.push(dt * (step as f64 + previous / (previous - a)));
@@ -201,7 +202,7 @@ fn wave_speed<M: Model>(text: &str, bar: Bar) -> Wave {
     let (omega, spread) = match bar {
         Bar::Free => {
             s.sim.compute_forces();
-            modal_frequency(&mut s.sim, &shape, steps)
+            modal_frequency(&mut s.sim, &mut Local, &shape, steps)
         }
         Bar::Periodic => {
             // Periodic images are ghosts of a procCube: one procCube on this thread.
@@ -209,7 +210,7 @@ fn wave_speed<M: Model>(text: &str, bar: Bar) -> Wave {
                 .unwrap_or_else(|e| panic!("{e}"));
             let mut cube = parallel::thread_cubes(&s, &layout).pop().unwrap();
             cube.start();
-            modal_frequency(&mut cube.sim, &shape, steps)
+            modal_frequency(&mut cube.sim, &mut cube.wall, &shape, steps)
         }
     };
     Wave {

@@ -67,6 +67,13 @@ pub struct RunOptions {
     pub restart: Option<PathBuf>,
 }
 
+/// Runs a deck with the model of type `M`, which need not be in the registry (a model written
+/// in a test, an example or another crate): the deck's `[model] name` is not consulted.
+pub fn run_model<M: Model>(scene: &Scene, opts: &RunOptions) -> Result<Summary, String> {
+    let setup = setup::build_as::<M>(scene).map_err(|e| e.to_string())?;
+    run_setup(setup, scene, opts)
+}
+
 /// Runs a deck to the end.
 pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Summary, String> {
     struct Visit<'a>(&'a Scene, &'a RunOptions);

@@ -5,16 +5,18 @@
 //! checked against the dimension the key expects and converted once into the deck's unit system
 //! (see [`crate::input::units`]); anything semantically wrong is reported with the entry's line.
 
+pub use super::materials::MaterialLines;
+use super::materials::{self, MaterialSection};
 use crate::engine::boundary::{History, Motion, TEMPERATURE};
 use crate::engine::simulation::Integrator;
 use crate::input::bars::Prestrain;
 use crate::input::geometry::{Bar, Lattice, Op, Shape};
 use crate::input::procs::{Procs, Walls};
 use crate::input::units::{
-    AccelerationVector, Area, Density, EnergyPerArea, ForceVector, Length, Micromodulus, Position,
-    Stress, Time, UnitSystem, Vector, VelocityVector,
+    AccelerationVector, Area, ForceVector, Length, Position, Stress, Time, UnitSystem, Vector,
+    VelocityVector,
 };
-use crate::model::{Material, MaterialKind, OptionValue};
+use crate::model::{Dimension, Material, ModelError, OptionValue};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::fmt;
@@ -139,33 +141,6 @@ struct LatticeSection {
     jitter: f64,
     #[serde(default)]
     seed: u64,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MaterialSection {
-    kind: Option<String>,
-    density: Density,
-    #[serde(alias = "E")]
-    youngs_modulus: Option<Stress>,
-    #[serde(alias = "nu")]
-    poisson_ratio: Option<f64>,
-    #[serde(alias = "K")]
-    bulk_modulus: Option<Stress>,
-    micromodulus: Option<Micromodulus>,
-    critical_stretch: Option<f64>,
-    #[serde(alias = "G0")]
-    fracture_energy: Option<EnergyPerArea>,
-    tensile_stretch: Option<f64>,
-    compressive_stretch: Option<f64>,
-    yield_stretch: Option<f64>,
-    failure_stretch: Option<f64>,
-    #[serde(alias = "fc")]
-    compressive_strength: Option<Stress>,
-    /// Heat conduction and expansion: plain numbers in the deck's units and degrees.
-    thermal_conductivity: Option<f64>,
-    specific_heat: Option<f64>,
-    thermal_expansion: Option<f64>,
 }
 
 /// A shape for geometry entries and regions; which keys apply depends on `shape`.
@@ -474,8 +449,9 @@ pub struct Scene {
     pub model: String,
     pub model_line: usize,
     pub model_options: Vec<(String, OptionValue)>,
-    /// Deck line of each material (same order as `materials`) and of `[time]`, for messages.
-    pub material_lines: Vec<usize>,
+    /// Where each material and its keys are (same order as `materials`), for messages.
+    pub material_lines: Vec<MaterialLines>,
+    /// Deck line of `[time]`, for messages.
     pub time_line: usize,
     pub horizon: f64,
     pub spacing: f64,
@@ -504,14 +480,17 @@ pub struct Scene {
 
 impl Scene {
     /// An error from building the model: located at the material it names, else at `[model]`.
-    pub fn model_error(&self, message: &str) -> DeckError {
-        let line = self
-            .materials
-            .iter()
-            .position(|m| message.contains(&format!("material '{}'", m.name)))
-            .map(|k| self.material_lines[k])
-            .unwrap_or(self.model_line);
-        self.error(Some(line), format!("[model] {message}"))
+    /// An error from building the model: at the key or the material it is about, else at
+    /// `[model]`.
+    pub fn model_error(&self, e: &ModelError) -> DeckError {
+        let line = match e {
+            ModelError::Material { material, .. } => self
+                .material_lines
+                .get(*material as usize)
+                .map_or(self.model_line, |m| m.of(e)),
+            ModelError::Model(_) => self.model_line,
+        };
+        self.error(Some(line), format!("[model] {e}"))
     }
 
     /// An error located at `line` of this deck.
@@ -584,6 +563,14 @@ struct Converter {
 type R<T> = Result<T, DeckError>;
 
 impl Converter {
+    fn error_at(&self, line: usize, message: String) -> DeckError {
+        DeckError {
+            file: self.file.clone(),
+            line: Some(line),
+            message,
+        }
+    }
+
     fn err<T>(&self, line: usize, message: impl Into<String>) -> R<T> {
         Err(DeckError {
             file: self.file.clone(),
@@ -602,23 +589,7 @@ impl Converter {
             .or_else(|e| self.err(units_line, format!("units: {e}")))?;
         let sys = self.sys;
 
-        // Materials, in name order; their index is the material id.
-        let mat_names: Vec<String> = deck.materials.get_ref().keys().cloned().collect();
-        if mat_names.is_empty() {
-            return self.err(
-                self.line_of(&deck.materials),
-                "[materials] defines no material",
-            );
-        }
-        if mat_names.len() > u16::MAX as usize {
-            return self.err(self.line_of(&deck.materials), "too many materials");
-        }
-        let mut materials = Vec::new();
-        let mut material_lines = Vec::new();
-        for (name, m) in deck.materials.get_ref() {
-            materials.push(self.material(name, m)?);
-            material_lines.push(self.line_of(m));
-        }
+        let (mat_names, materials, material_lines) = self.materials(&deck.materials)?;
         let material_id = |name: &str, line: usize| -> R<u16> {
             match mat_names.iter().position(|n| n == name) {
                 Some(i) => Ok(i as u16),
@@ -1205,79 +1176,34 @@ impl Converter {
         })
     }
 
-    fn material(&self, name: &str, m: &Spanned<MaterialSection>) -> R<Material> {
-        let line = self.line_of(m);
-        let s = m.get_ref();
-        let sys = self.sys;
-        let ctx = format!("material '{name}'");
-        let kind = match s.kind.as_deref().unwrap_or("solid") {
-            "solid" => MaterialKind::Solid,
-            "concrete" => MaterialKind::Concrete,
-            "steel" => MaterialKind::Steel,
-            other => {
-                return self.err(
-                    line,
-                    format!(
-                        "{ctx}: unknown kind '{other}' (use \"solid\", \"concrete\" or \"steel\")"
-                    ),
-                )
-            }
-        };
-        let density = s.density.value(sys);
-        if !(density.is_finite() && density > 0.0) {
-            return self.err(line, format!("{ctx}: density must be > 0 (got {density})"));
+    /// The materials in name order (their index is the material id), with where each key is.
+    fn materials(
+        &self,
+        section: &Spanned<BTreeMap<String, Spanned<MaterialSection>>>,
+    ) -> R<(Vec<String>, Vec<Material>, Vec<MaterialLines>)> {
+        let names: Vec<String> = section.get_ref().keys().cloned().collect();
+        if names.is_empty() {
+            return self.err(self.line_of(section), "[materials] defines no material");
         }
-        let positive = |v: Option<f64>, key: &str| -> R<Option<f64>> {
-            match v {
-                Some(x) if !(x.is_finite() && x > 0.0) => {
-                    self.err(line, format!("{ctx}: {key} must be > 0 (got {x})"))
-                }
-                _ => Ok(v),
-            }
-        };
-        let mut mat = Material::new(name, kind, density);
-        mat.youngs_modulus = positive(s.youngs_modulus.map(|q| q.value(sys)), "youngs_modulus")?;
-        mat.bulk_modulus = positive(s.bulk_modulus.map(|q| q.value(sys)), "bulk_modulus")?;
-        mat.micromodulus = positive(s.micromodulus.map(|q| q.value(sys)), "micromodulus")?;
-        mat.fracture_energy = positive(s.fracture_energy.map(|q| q.value(sys)), "fracture_energy")?;
-        mat.critical_stretch = positive(s.critical_stretch, "critical_stretch")?;
-        mat.tensile_stretch = positive(s.tensile_stretch, "tensile_stretch")?;
-        mat.yield_stretch = positive(s.yield_stretch, "yield_stretch")?;
-        mat.failure_stretch = positive(s.failure_stretch, "failure_stretch")?;
-        mat.compressive_strength = positive(
-            s.compressive_strength.map(|q| q.value(sys)),
-            "compressive_strength",
-        )?;
-        if let Some(c) = s.compressive_stretch {
-            if !(c.is_finite() && c < 0.0) {
-                return self.err(
-                    line,
-                    format!("{ctx}: compressive_stretch must be < 0 (got {c})"),
-                );
-            }
+        if names.len() > u16::MAX as usize {
+            return self.err(self.line_of(section), "too many materials");
         }
-        mat.compressive_stretch = s.compressive_stretch;
-        if let Some(nu) = s.poisson_ratio {
-            if !(nu > -1.0 && nu < 0.5) {
-                return self.err(
-                    line,
-                    format!("{ctx}: poisson_ratio must lie in (-1, 0.5) (got {nu})"),
-                );
-            }
+        let line_of = |v: &Spanned<_>| self.line_of(v);
+        let (mut materials, mut lines) = (Vec::new(), Vec::new());
+        for (k, (name, m)) in section.get_ref().iter().enumerate() {
+            let (material, at) = materials::read(
+                name,
+                k as u16,
+                m.get_ref(),
+                self.line_of(m),
+                self.sys,
+                &line_of,
+            )
+            .map_err(|(line, message)| self.error_at(line, message))?;
+            materials.push(material);
+            lines.push(at);
         }
-        mat.poisson_ratio = s.poisson_ratio;
-        mat.thermal_conductivity = positive(s.thermal_conductivity, "thermal_conductivity")?;
-        mat.specific_heat = positive(s.specific_heat, "specific_heat")?;
-        if let Some(a) = s.thermal_expansion {
-            if !a.is_finite() {
-                return self.err(
-                    line,
-                    format!("{ctx}: thermal_expansion must be finite (got {a})"),
-                );
-            }
-        }
-        mat.thermal_expansion = s.thermal_expansion;
-        Ok(mat)
+        Ok((names, materials, lines))
     }
 
     /// A vector from the deck, refused if any component is not a finite number.
@@ -1526,7 +1452,10 @@ impl Converter {
                 return Ok(Prestrain::default());
             }
             (Some(e), None) => e,
-            (None, Some(stress)) => match material.youngs_modulus {
+            (None, Some(stress)) => match material
+                .positive("youngs_modulus", Dimension::STRESS)
+                .or_else(|e| self.err(line, e.to_string()))?
+            {
                 Some(e) => stress.value(self.sys) / e,
                 None => {
                     return self.err(

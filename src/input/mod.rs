@@ -5,6 +5,7 @@
 pub mod bars;
 pub mod deck;
 pub mod geometry;
+pub mod materials;
 pub mod procs;
 pub mod setup;
 pub mod units;

@@ -477,18 +477,16 @@ fn bar_bonds<M: Model>(
     if scene.bars.is_empty() {
         return Ok(BarBonds::default());
     }
-    let modulus: Vec<f64> = scene
-        .bars
-        .iter()
-        .map(|b| {
-            scene.materials[b.material as usize]
-                .youngs_modulus
-                .unwrap_or_else(|| {
-                    let (l, mu) = model.lame(b.material);
-                    mu * (3.0 * l + 2.0 * mu) / (l + mu)
-                })
-        })
-        .collect();
+    let mut modulus = Vec::with_capacity(scene.bars.len());
+    for b in &scene.bars {
+        let given = scene.materials[b.material as usize]
+            .positive("youngs_modulus", crate::model::Dimension::STRESS)
+            .map_err(|e| scene.model_error(&e))?;
+        modulus.push(given.unwrap_or_else(|| {
+            let (l, mu) = model.lame(b.material);
+            mu * (3.0 * l + 2.0 * mu) / (l + mu)
+        }));
+    }
     let factor = if <M::State as Attributes>::LEN == 0 {
         crate::input::bars::calibrate(
             model,

@@ -7,6 +7,7 @@
 //! point because a length typed where a stress belongs is far easier to fix from
 //! a load error (toml adds line and column) than from a run that blows up.
 
+use crate::model::{Dimension, Written};
 use serde::de::{self, Deserialize, Deserializer, SeqAccess, Visitor};
 use std::fmt;
 use std::str::FromStr;
@@ -341,20 +342,61 @@ fn convert(v: f64, ratio: f64) -> f64 {
 impl<const M: i8, const L: i8, const T: i8> FromStr for Quantity<M, L, T> {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        if let Ok(v) = s.trim().parse::<f64>() {
-            return Ok(Self::plain(v));
+        parse_as(s, Self::DIM).map(Quantity)
+    }
+}
+
+/// A deck string of dimension `dim`: a plain number, or a number with a unit of that
+/// dimension.
+fn parse_as(s: &str, dim: Dim) -> Result<Repr, String> {
+    if let Ok(v) = s.trim().parse::<f64>() {
+        return Ok(Repr::Plain(v));
+    }
+    let (v, factor, found) = parse_parts(s).map_err(|e| {
+        if e.contains("expected a number followed by a unit") {
+            format!("{e}, e.g. \"{}\"", dim.example())
+        } else {
+            e
         }
-        let (v, factor, dim) = parse_parts(s).map_err(|e| {
-            if e.contains("expected a number followed by a unit") {
-                format!("{e}, e.g. \"{}\"", Self::DIM.example())
-            } else {
-                e
+    })?;
+    if found != dim {
+        return Err(mismatch(dim, s, found));
+    }
+    Ok(Repr::Unit(v, factor))
+}
+
+/// What a model reads of a material key, converted as [`Quantity::value`] converts: the
+/// dimension is the model's, known only when it asks.
+impl crate::model::Units for UnitSystem {
+    fn value(&self, written: &Written, dim: Dimension) -> Result<f64, String> {
+        let dim = Dim::new(dim.mass, dim.length, dim.time);
+        let repr = match written {
+            Written::Number(v) => Repr::Plain(*v),
+            Written::Text(s) => parse_as(s, dim)?,
+            Written::Other(what) => {
+                return Err(format!(
+                    "expected {} as a number or a string like \"{}\", not {what}",
+                    dim.with_article(),
+                    dim.example()
+                ))
             }
-        })?;
-        if dim != Self::DIM {
-            return Err(mismatch(Self::DIM, s, dim));
+        };
+        Ok(match repr {
+            Repr::Plain(v) => v,
+            Repr::Si(v) => v / self.si_factor(dim),
+            Repr::Unit(v, factor) => convert(v, factor / self.si_factor(dim)),
+        })
+    }
+}
+
+impl UnitSystem {
+    /// This system as the converter a model's materials read through.
+    pub fn as_units(self) -> &'static dyn crate::model::Units {
+        match self {
+            UnitSystem::Si => &UnitSystem::Si,
+            UnitSystem::InchPoundSecond => &UnitSystem::InchPoundSecond,
+            UnitSystem::MmNewtonSecond => &UnitSystem::MmNewtonSecond,
         }
-        Ok(Quantity(Repr::Unit(v, factor)))
     }
 }
 

@@ -6,135 +6,13 @@
 
 pub mod attributes;
 pub mod lanes;
+pub mod material;
+pub mod rotation;
+
+pub use material::{Dimension, Material, MaterialKind, ModelError, PairTable, Units, Written};
 
 use crate::model::attributes::Attributes;
 use crate::model::lanes::{LaneForces, LANES};
-
-/// What a material is made of, as far as a model needs to know to pick a bond law.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MaterialKind {
-    /// A generic elastic-brittle solid.
-    Solid,
-    /// Plain concrete (the thesis's `ConcConc` law).
-    Concrete,
-    /// Reinforcing or prestressing steel.
-    Steel,
-}
-
-impl MaterialKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            MaterialKind::Solid => "solid",
-            MaterialKind::Concrete => "concrete",
-            MaterialKind::Steel => "steel",
-        }
-    }
-}
-
-/// A material as the deck describes it, already in the deck's unit system. Models read the
-/// properties they need and report the ones that are missing.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Material {
-    pub name: String,
-    pub kind: MaterialKind,
-    pub density: f64,
-    pub youngs_modulus: Option<f64>,
-    pub poisson_ratio: Option<f64>,
-    pub bulk_modulus: Option<f64>,
-    pub micromodulus: Option<f64>,
-    pub critical_stretch: Option<f64>,
-    pub fracture_energy: Option<f64>,
-    pub tensile_stretch: Option<f64>,
-    pub compressive_stretch: Option<f64>,
-    pub yield_stretch: Option<f64>,
-    pub failure_stretch: Option<f64>,
-    pub compressive_strength: Option<f64>,
-    pub thermal_conductivity: Option<f64>,
-    pub specific_heat: Option<f64>,
-    pub thermal_expansion: Option<f64>,
-}
-
-impl Material {
-    /// A material with only a name, kind and density; the rest is filled in by the caller.
-    pub fn new(name: &str, kind: MaterialKind, density: f64) -> Self {
-        Material {
-            name: name.to_string(),
-            kind,
-            density,
-            youngs_modulus: None,
-            poisson_ratio: None,
-            bulk_modulus: None,
-            micromodulus: None,
-            critical_stretch: None,
-            fracture_energy: None,
-            tensile_stretch: None,
-            compressive_stretch: None,
-            yield_stretch: None,
-            failure_stretch: None,
-            compressive_strength: None,
-            thermal_conductivity: None,
-            specific_heat: None,
-            thermal_expansion: None,
-        }
-    }
-
-    /// Names of the optional properties the deck set.
-    pub fn given(&self) -> Vec<&'static str> {
-        [
-            ("youngs_modulus", self.youngs_modulus.is_some()),
-            ("poisson_ratio", self.poisson_ratio.is_some()),
-            ("bulk_modulus", self.bulk_modulus.is_some()),
-            ("micromodulus", self.micromodulus.is_some()),
-            ("critical_stretch", self.critical_stretch.is_some()),
-            ("fracture_energy", self.fracture_energy.is_some()),
-            ("tensile_stretch", self.tensile_stretch.is_some()),
-            ("compressive_stretch", self.compressive_stretch.is_some()),
-            ("yield_stretch", self.yield_stretch.is_some()),
-            ("failure_stretch", self.failure_stretch.is_some()),
-            ("thermal_conductivity", self.thermal_conductivity.is_some()),
-            ("specific_heat", self.specific_heat.is_some()),
-            ("thermal_expansion", self.thermal_expansion.is_some()),
-        ]
-        .into_iter()
-        .filter(|(_, set)| *set)
-        .map(|(k, _)| k)
-        .collect()
-    }
-
-    /// Refuses properties the model would silently ignore (`compressive_strength` is always
-    /// allowed: it feeds reference values such as f_r = 7.5√f'c, not the physics).
-    pub fn only_uses(&self, used: &[&str], model: &str) -> Result<(), String> {
-        for k in self.given() {
-            if !used.contains(&k) {
-                return Err(format!(
-                    "material '{}': model '{model}' does not use '{k}' (it reads {})",
-                    self.name,
-                    used.join(", ")
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    /// The critical stretch: `critical_stretch` as given, or from `fracture_energy` G0 by the
-    /// model's formula `from_energy(G0)`, or none (∞: the bonds never break); both is an error.
-    pub fn critical_stretch_or(&self, from_energy: impl FnOnce(f64) -> f64) -> Result<f64, String> {
-        match (self.critical_stretch, self.fracture_energy) {
-            (Some(s), None) => Ok(s),
-            (None, Some(g0)) => Ok(from_energy(g0)),
-            (None, None) => Ok(f64::INFINITY),
-            (Some(_), Some(_)) => Err(format!(
-                "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
-                self.name
-            )),
-        }
-    }
-
-    /// A property the model cannot do without.
-    pub fn require(&self, value: Option<f64>, key: &str, model: &str) -> Result<f64, String> {
-        value.ok_or_else(|| format!("material '{}' needs '{key}' for model '{model}'", self.name))
-    }
-}
 
 /// A value of `[model.options]`: a number or a word (`influence = "gaussian"`).
 #[derive(Clone, Debug, PartialEq)]
@@ -277,7 +155,7 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     /// one material it looks it up once per pass, so the bond loop carries no material dispatch.
     type Law: Copy + Send + Sync + 'static;
 
-    fn build(b: &ModelBuild) -> Result<Self, String>;
+    fn build(b: &ModelBuild) -> Result<Self, ModelError>;
 
     /// Whether a bond of this scene can break (some critical stretch is finite). When none can,
     /// the engine runs the pair pass without damage bookkeeping: no broken flags read or
@@ -504,14 +382,14 @@ macro_rules! model_registry {
             name: &str,
             build: &$crate::model::ModelBuild,
             visitor: V,
-        ) -> Result<V::Output, String> {
+        ) -> Result<V::Output, $crate::model::ModelError> {
             $(
                 if name == <$ty as $crate::model::Model>::NAME {
                     let model = <$ty as $crate::model::Model>::build(build)?;
                     return Ok(visitor.visit(model));
                 }
             )+
-            Err(format!("unknown model '{}' (known models: {})", name, names().join(", ")))
+            Err(format!("unknown model '{}' (known models: {})", name, names().join(", ")).into())
         }
     };
 }
