@@ -47,6 +47,6 @@ fn a_time_step_above_the_bound_stops_the_run_with_a_diagnosis_and_inspection_fil
     );
     // The inspection checkpoint reads back.
     let c = pdq::output::checkpoint::Checkpoint::read(&checkpoint).unwrap();
-    assert_eq!(c.step, step);
+    assert_eq!(c.state.step, step);
     let _ = std::fs::remove_dir_all(dir);
 }

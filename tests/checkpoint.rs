@@ -199,7 +199,7 @@ fn a_run_killed_while_writing_a_checkpoint_resumes_from_the_previous_one() {
     // The half-written file is not a checkpoint; the previous one loads.
     assert!(Checkpoint::read(&tmp).is_err());
     let (path, c) = pdq::output::checkpoint::resolve(&out).unwrap();
-    assert_eq!(c.step, 200, "resumes from {}", path.display());
+    assert_eq!(c.state.step, 200, "resumes from {}", path.display());
     pdq_run_ok(&deck, &out, &["--restart", &from]);
     let straight = work.join("straight");
     pdq_run_ok(&deck, &straight, &[]);
@@ -244,13 +244,13 @@ fn sigterm_writes_a_checkpoint_and_the_run_resumes_from_it() {
     );
     assert!(stderr.contains("--restart"), "says how to resume: {stderr}");
     let (_, c) = pdq::output::checkpoint::resolve(&out).unwrap();
-    assert!(c.step > 0);
+    assert!(c.state.step > 0);
     eprintln!(
         "SIGTERM: stopped at step {} with a checkpoint; {stderr}",
-        c.step
+        c.state.step
     );
     // Resuming to a few steps further matches a run that went there straight.
-    let end = (c.step + 50).to_string();
+    let end = (c.state.step + 50).to_string();
     let from = out.to_str().unwrap().to_string();
     pdq_run_ok(
         &deck,
@@ -376,6 +376,6 @@ fn checkpoints_on_the_wall_clock_keep_the_newest() {
     assert!(s.checkpoints.len() > 2, "{} written", s.checkpoints.len());
     assert_eq!(on_disk, 2);
     let (_, c) = pdq::output::checkpoint::resolve(&dir).unwrap();
-    assert_eq!(c.step, 500, "the last step always gets one");
+    assert_eq!(c.state.step, 500, "the last step always gets one");
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -198,7 +198,6 @@ const STILL_LONG: &[(&str, &str, usize)] = &[
     ("src/lab/validate/girder.rs", "prestressed_girder", 176),
     ("src/lab/validate.rs", "", 1452),
     ("src/main.rs", "main", 159),
-    ("src/output/checkpoint.rs", "", 747),
     ("src/parallel/shuffle.rs", "shuffle", 252),
     ("src/solve/implicit.rs", "assemble_tangent", 148),
 ];

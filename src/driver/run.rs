@@ -177,9 +177,7 @@ fn run_setup<M: Model>(
         (None, Some(until)) => {
             let walls = opts.walls.unwrap_or(scene.parallel.walls);
             let at = |e: String| format!("{}:{}: {e}", scene.file, scene.time_line);
-            let s =
-                crate::solve::static_start::solve(&setup, until, walls, scene_hash, &scene.file)
-                    .map_err(at)?;
+            let s = crate::solve::static_start::solve(&setup, until, walls).map_err(at)?;
             let stop = scene.time.stop_at_broken_bonds;
             if stop > 0 && s.broken as u64 >= stop {
                 return Err(at(format!(
@@ -187,14 +185,24 @@ fn run_setup<M: Model>(
                     s.broken
                 )));
             }
-            s.checkpoint.restore_particles(&mut setup);
+            s.state.restore_particles(&mut setup);
             Some(s)
         }
         _ => None,
     };
+    let restart_line = resume.as_ref().map(|c| {
+        format!(
+            "restart    from step {} (t = {:.6e}) of {}: {} broken bonds",
+            c.state.step,
+            c.state.time,
+            c.deck,
+            c.state.broken.len()
+        )
+    });
     let resume = resume
         .as_ref()
-        .or(static_start.as_ref().map(|s| &s.checkpoint));
+        .map(|c| &c.state)
+        .or(static_start.as_ref().map(|s| &s.state));
     // Said after the run's header (`prepare`), by the root only.
     let static_line = static_start.as_ref().map(|s| s.describe());
     let say_static = |quiet: bool| {
@@ -202,14 +210,8 @@ fn run_setup<M: Model>(
             eprintln!("{line}");
         }
     };
-    if let (Some(c), false) = (resume.filter(|_| static_start.is_none()), opts.quiet) {
-        eprintln!(
-            "restart    from step {} (t = {:.6e}) of {}: {} broken bonds",
-            c.step,
-            c.time,
-            c.deck,
-            c.broken.len()
-        );
+    if let (Some(line), false) = (&restart_line, opts.quiet) {
+        eprintln!("{line}");
     }
     // The implicit solve assembles one matrix in one process.
     let one_cube = |layout: &Layout| -> Result<(), String> {
@@ -328,35 +330,35 @@ fn resume_from<M: Model>(
     c.check_matches::<M>(&path, scene_hash, setup.sim.particles.len())?;
     // Steps count from the run's start (`[time] static_until`, or 0): a checkpoint of a run
     // that started elsewhere would end the restart at another time.
-    let began = c.time - c.step as f64 * c.dt;
-    if (began - start).abs() > 1e-6 * (c.time.abs() + c.dt) {
+    let began = c.state.time - c.state.step as f64 * c.state.dt;
+    if (began - start).abs() > 1e-6 * (c.state.time.abs() + c.state.dt) {
         return Err(format!(
             "checkpoint {}: its run started at t = {began:.6e} (step {} at t = {:.6e}), the deck now starts at t = {start:.6e} ([time] static_until); a restart continues the same run",
             path.display(),
-            c.step,
-            c.time
+            c.state.step,
+            c.state.time
         ));
     }
     let sim = &setup.sim;
-    if c.dt != sim.dt || checkpoint::integrator(&c.integrator) != Some(sim.integrator) {
+    if c.state.dt != sim.dt || checkpoint::integrator(&c.state.integrator) != Some(sim.integrator) {
         return Err(format!(
             "checkpoint {}: it was written with time step {:e} ({}), the deck now gives {:e} ({}); a restart continues with the same integration",
             path.display(),
-            c.dt,
-            c.integrator,
+            c.state.dt,
+            c.state.integrator,
             sim.dt,
             sim.integrator.name()
         ));
     }
-    if c.step >= setup.steps {
+    if c.state.step >= setup.steps {
         return Err(format!(
             "checkpoint {} is at step {}, the run ends at step {}: nothing to do (give more steps with --steps)",
             path.display(),
-            c.step,
+            c.state.step,
             setup.steps
         ));
     }
-    c.restore_particles(setup);
+    c.state.restore_particles(setup);
     Ok(c)
 }
 

@@ -9,6 +9,7 @@ use crate::model::Model;
 use crate::output::checkpoint::Checkpoint;
 use crate::output::{Frames, History, Progress};
 use crate::parallel::comm::{Reduce, Transport};
+use crate::parallel::snapshot::Snapshot;
 use crate::parallel::Cube;
 use crate::solve::{Adr, Explicit, Newton, Relaxed, Solver};
 use std::path::PathBuf;
@@ -294,7 +295,7 @@ pub(crate) fn drive<M: Model>(
     mut cube: Cube<M>,
     plan: &Plan,
     mut store: Option<FrameStore<M>>,
-    resume: Option<&Checkpoint>,
+    resume: Option<&Snapshot>,
 ) -> Result<Option<Summary>, String> {
     let root = cube.wall.transport().rank() == 0;
     start(&mut cube, resume);
@@ -341,7 +342,7 @@ pub(crate) fn drive<M: Model>(
 }
 
 /// Restores a checkpoint's bonds, makes the bond counts whole, computes the first forces.
-fn start<M: Model>(cube: &mut Cube<M>, resume: Option<&Checkpoint>) {
+fn start<M: Model>(cube: &mut Cube<M>, resume: Option<&Snapshot>) {
     let t = Instant::now();
     if let Some(c) = resume {
         c.restore_bonds(cube);

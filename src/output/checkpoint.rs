@@ -13,9 +13,9 @@
 
 use crate::engine::simulation::Integrator;
 use crate::input::setup::Setup;
-use crate::model::attributes::Attributes;
 use crate::model::Model;
-use crate::parallel::comm::f64s;
+use crate::parallel::snapshot::schema;
+pub use crate::parallel::snapshot::Snapshot;
 use crate::parallel::Cube;
 use hdf5_pure::AttrValue;
 use std::collections::HashMap;
@@ -25,47 +25,13 @@ use std::path::{Path, PathBuf};
 const FORMAT: &str = "pdq-checkpoint";
 const VERSION: i64 = 1;
 
-/// A run's state at the end of a step, by global id.
+/// A run's state at the end of a step, by global id, and what identifies its scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkpoint {
-    pub step: u64,
-    pub time: f64,
-    pub dt: f64,
-    pub integrator: String,
-    pub model: String,
-    /// `name:len` of each alterable field, `|`, the bond history's, `|`, the force's.
-    pub schema: String,
+    pub state: Snapshot,
     pub scene_hash: u64,
     /// The deck file the run was started from (informational).
     pub deck: String,
-    pub x0: Vec<[f64; 3]>,
-    /// Alterable records, `Alter::LEN` values per particle, by global id.
-    pub alter: Vec<f64>,
-    /// The generalized forces of the last evaluation, `Force::LEN` per particle, by global id:
-    /// the integrator's state (velocity Verlet starts a step with them). Recomputing them would
-    /// not do: an LPS bond that broke in the last pair pass still counted in its state pass.
-    pub force: Vec<f64>,
-    /// Broken bonds, (smaller, larger) global id, sorted.
-    pub broken: Vec<(u32, u32)>,
-    /// Bonds with a non-zero history, sorted, and their histories (`Bond::LEN` each).
-    pub history_pairs: Vec<(u32, u32)>,
-    pub history: Vec<f64>,
-}
-
-/// The names and lengths of the alterable and bond-history fields of `M`.
-pub fn schema<M: Model>() -> String {
-    let fields = |f: &[crate::model::attributes::Field]| {
-        f.iter()
-            .map(|f| format!("{}:{}", f.name, f.len))
-            .collect::<Vec<_>>()
-            .join(",")
-    };
-    format!(
-        "{}|{}|{}",
-        fields(<M::Alter as Attributes>::FIELDS),
-        fields(<M::Bond as Attributes>::FIELDS),
-        fields(<M::Force as Attributes>::FIELDS)
-    )
 }
 
 /// 64-bit FNV-1a: a fixed, documented hash (Rust's `Hasher`s may change between releases).
@@ -114,18 +80,18 @@ pub fn scene_hash<M: Model>(setup: &Setup<M>, scene: &crate::input::deck::Scene)
 
 fn checksum(c: &Checkpoint) -> u64 {
     let mut h = Fnv::new();
-    h.bytes(&c.step.to_le_bytes());
-    h.f64s(&[c.time, c.dt]);
-    for x in &c.x0 {
+    h.bytes(&c.state.step.to_le_bytes());
+    h.f64s(&[c.state.time, c.state.dt]);
+    for x in &c.state.x0 {
         h.f64s(x);
     }
-    h.f64s(&c.alter);
-    h.f64s(&c.force);
-    for &(a, b) in c.broken.iter().chain(&c.history_pairs) {
+    h.f64s(&c.state.alter);
+    h.f64s(&c.state.force);
+    for &(a, b) in c.state.broken.iter().chain(&c.state.history_pairs) {
         h.bytes(&a.to_le_bytes());
         h.bytes(&b.to_le_bytes());
     }
-    h.f64s(&c.history);
+    h.f64s(&c.state.history);
     h.0
 }
 
@@ -135,120 +101,49 @@ pub fn file_name(step: u64) -> String {
 }
 
 impl Checkpoint {
-    /// Gathers the state of every procCube on the root, which gets the checkpoint; every
+    /// The state of every procCube gathered on the root, which gets the checkpoint; every
     /// worker must call it.
     pub fn gather<M: Model>(cube: &mut Cube<M>, scene_hash: u64, deck: &str) -> Option<Checkpoint> {
-        let la = <M::Alter as Attributes>::LEN;
-        let lb = <M::Bond as Attributes>::LEN;
-        let lf = <M::Force as Attributes>::LEN;
-        let p = &cube.sim.particles;
-        let mut mine: Vec<f64> = Vec::with_capacity(p.n_owned * (4 + la + lf));
-        for i in 0..p.n_owned {
-            mine.push(p.gid[i] as f64);
-            mine.extend_from_slice(&p.x0[i]);
-            mine.extend_from_slice(p.alter[i].as_slice());
-            mine.extend_from_slice(p.force[i].as_slice());
-        }
-        let b = &cube.sim.bonds;
-        let mut bonds: Vec<f64> = Vec::new();
-        for (i, j, k) in b.iter() {
-            let h = b.history[k].as_slice();
-            if b.broken[k] || h.iter().any(|&x| x != 0.0) {
-                let (gi, gj) = (p.gid[i], p.gid[j]);
-                bonds.push(gi.min(gj) as f64);
-                bonds.push(gi.max(gj) as f64);
-                bonds.push(if b.broken[k] { 1.0 } else { 0.0 });
-                bonds.extend_from_slice(h);
-            }
-        }
-        // Bonds a shuffle dropped once broken: broken, history no longer needed.
-        for &(a, c) in &cube.dropped {
-            bonds.extend_from_slice(&[a as f64, c as f64, 1.0]);
-            bonds.extend(std::iter::repeat_n(0.0, lb));
-        }
-        let (step, time, dt) = (cube.sim.step, cube.sim.time, cube.sim.dt);
-        let integrator = cube.sim.integrator.name().to_string();
-        let n = cube.global_particles;
-        let mut team = cube.team();
-        let particles = team.gather(bytemuck::cast_slice(&mine));
-        let bonds = team.gather(bytemuck::cast_slice(&bonds));
-        let (particles, bonds) = (particles?, bonds?);
-        let mut x0 = vec![[f64::NAN; 3]; n];
-        let mut alter = vec![f64::NAN; n * la];
-        let mut force = vec![f64::NAN; n * lf];
-        for bytes in particles {
-            for r in f64s(&bytes).chunks_exact(4 + la + lf) {
-                let g = r[0] as usize;
-                x0[g] = [r[1], r[2], r[3]];
-                alter[g * la..(g + 1) * la].copy_from_slice(&r[4..4 + la]);
-                force[g * lf..(g + 1) * lf].copy_from_slice(&r[4 + la..]);
-            }
-        }
-        let mut rows: Vec<(u32, u32, bool, Vec<f64>)> = Vec::new();
-        for bytes in bonds {
-            for r in f64s(&bytes).chunks_exact(3 + lb) {
-                rows.push((r[0] as u32, r[1] as u32, r[2] != 0.0, r[3..].to_vec()));
-            }
-        }
-        rows.sort_by_key(|r| (r.0, r.1));
-        let mut c = Checkpoint {
-            step,
-            time,
-            dt,
-            integrator,
-            model: M::NAME.to_string(),
-            schema: schema::<M>(),
+        Some(Checkpoint {
+            state: Snapshot::gather(cube)?,
             scene_hash,
             deck: deck.to_string(),
-            x0,
-            alter,
-            force,
-            broken: Vec::new(),
-            history_pairs: Vec::new(),
-            history: Vec::new(),
-        };
-        for (a, b, broken, h) in rows {
-            if broken {
-                c.broken.push((a, b));
-            }
-            if h.iter().any(|&x| x != 0.0) {
-                c.history_pairs.push((a, b));
-                c.history.extend_from_slice(&h);
-            }
-        }
-        Some(c)
+        })
     }
 
     /// Writes the checkpoint as `dir/checkpoint_SSSSSSSS.h5` (atomically), then deletes all but
     /// the newest `keep` checkpoints in `dir`; returns the path and the size in bytes.
     pub fn write(&self, dir: &Path, keep: usize) -> std::io::Result<(PathBuf, u64)> {
         std::fs::create_dir_all(dir)?;
-        let path = dir.join(file_name(self.step));
+        let path = dir.join(file_name(self.state.step));
         let mut b = hdf5_pure::FileBuilder::new();
         let s = |v: &str| AttrValue::String(v.to_string());
         b.set_attr("format", s(FORMAT));
         b.set_attr("version", AttrValue::I64(VERSION));
-        b.set_attr("step", AttrValue::U64(self.step));
-        b.set_attr("time", AttrValue::F64(self.time));
-        b.set_attr("dt", AttrValue::F64(self.dt));
-        b.set_attr("integrator", s(&self.integrator));
-        b.set_attr("model", s(&self.model));
-        b.set_attr("schema", s(&self.schema));
+        b.set_attr("step", AttrValue::U64(self.state.step));
+        b.set_attr("time", AttrValue::F64(self.state.time));
+        b.set_attr("dt", AttrValue::F64(self.state.dt));
+        b.set_attr("integrator", s(&self.state.integrator));
+        b.set_attr("model", s(&self.state.model));
+        b.set_attr("schema", s(&self.state.schema));
         b.set_attr("scene_hash", AttrValue::U64(self.scene_hash));
         b.set_attr("deck", s(&self.deck));
-        b.set_attr("particles", AttrValue::U64(self.x0.len() as u64));
-        b.set_attr("broken_bonds", AttrValue::U64(self.broken.len() as u64));
+        b.set_attr("particles", AttrValue::U64(self.state.x0.len() as u64));
+        b.set_attr(
+            "broken_bonds",
+            AttrValue::U64(self.state.broken.len() as u64),
+        );
         b.set_attr("checksum", AttrValue::U64(checksum(self)));
-        let n = self.x0.len() as u64;
-        let x0: Vec<f64> = self.x0.iter().flatten().copied().collect();
+        let n = self.state.x0.len() as u64;
+        let x0: Vec<f64> = self.state.x0.iter().flatten().copied().collect();
         b.create_dataset("x0")
             .with_f64_data(&x0)
             .with_shape(&[n, 3]);
         // One dataset per alterable field and per force field, by its declared name.
-        let parts: Vec<&str> = self.schema.split('|').collect();
+        let parts: Vec<&str> = self.state.schema.split('|').collect();
         for (prefix, fields, values) in [
-            ("alter", parts.first(), &self.alter),
-            ("force", parts.get(2), &self.force),
+            ("alter", parts.first(), &self.state.alter),
+            ("force", parts.get(2), &self.state.force),
         ] {
             let fields = parse_fields(fields.copied().unwrap_or(""));
             let len: usize = fields.iter().map(|f| f.1).sum();
@@ -267,15 +162,17 @@ impl Checkpoint {
         let pairs =
             |p: &[(u32, u32)]| -> Vec<u32> { p.iter().flat_map(|&(a, b)| [a, b]).collect() };
         b.create_dataset("broken_bonds")
-            .with_u32_data(&pairs(&self.broken))
-            .with_shape(&[self.broken.len() as u64, 2]);
-        let m = self.history_pairs.len() as u64;
+            .with_u32_data(&pairs(&self.state.broken))
+            .with_shape(&[self.state.broken.len() as u64, 2]);
+        let m = self.state.history_pairs.len() as u64;
         b.create_dataset("history_bonds")
-            .with_u32_data(&pairs(&self.history_pairs))
+            .with_u32_data(&pairs(&self.state.history_pairs))
             .with_shape(&[m, 2]);
-        let lb = (self.history.len() as u64).checked_div(m).unwrap_or(0);
+        let lb = (self.state.history.len() as u64)
+            .checked_div(m)
+            .unwrap_or(0);
         b.create_dataset("history")
-            .with_f64_data(&self.history)
+            .with_f64_data(&self.state.history)
             .with_shape(&[m, lb]);
         // A testing aid (tests/checkpoint.rs kills a run while it writes); not for users.
         let pause = std::env::var("PDQ_CHECKPOINT_PAUSE_MS")
@@ -322,24 +219,24 @@ impl Checkpoint {
                 path.display()
             ))
         };
-        if self.model != M::NAME {
+        if self.state.model != M::NAME {
             return refuse(format!(
                 "it is of model '{}', the deck uses '{}'",
-                self.model,
+                self.state.model,
                 M::NAME
             ));
         }
-        if self.schema != schema::<M>() {
+        if self.state.schema != schema::<M>() {
             return refuse(format!(
                 "its attributes are [{}], the model's are [{}]",
-                self.schema,
+                self.state.schema,
                 schema::<M>()
             ));
         }
-        if self.x0.len() != n {
+        if self.state.x0.len() != n {
             return refuse(format!(
                 "it holds {} particles, the deck builds {n}",
-                self.x0.len()
+                self.state.x0.len()
             ));
         }
         if self.scene_hash != scene_hash {
@@ -351,78 +248,21 @@ impl Checkpoint {
         Ok(())
     }
 
-    /// Puts the checkpoint's particles into a freshly built scene: reference positions (a
-    /// shuffle may have wrapped some around a periodic box), alterable attributes, time and
-    /// step. Bonds are marked per procCube by [`Checkpoint::restore_bonds`].
-    pub fn restore_particles<M: Model>(&self, setup: &mut Setup<M>) {
-        let la = <M::Alter as Attributes>::LEN;
-        let sim = &mut setup.sim;
-        let p = &mut sim.particles;
-        for i in 0..p.len() {
-            let g = p.gid[i] as usize;
-            p.x0[i] = self.x0[g];
-            p.alter[i]
-                .as_mut_slice()
-                .copy_from_slice(&self.alter[g * la..(g + 1) * la]);
-        }
-        sim.time = self.time;
-        sim.step = self.step;
-    }
-
-    /// Marks the broken bonds of a procCube and sets bond histories, by global ids; sets its
-    /// clock.
-    pub fn restore_bonds<M: Model>(&self, cube: &mut Cube<M>) {
-        let lb = <M::Bond as Attributes>::LEN;
-        let sim = &mut cube.sim;
-        sim.time = self.time;
-        sim.step = self.step;
-        let gid = &sim.particles.gid;
-        let key = |i: usize, j: usize| (gid[i].min(gid[j]), gid[i].max(gid[j]));
-        let b = &mut sim.bonds;
-        let bonds: Vec<(usize, usize, usize)> = b.iter().collect();
-        for (i, j, k) in bonds {
-            let pair = key(i, j);
-            if self.broken.binary_search(&pair).is_ok() {
-                b.broken[k] = true;
-            }
-            if lb > 0 {
-                if let Ok(at) = self.history_pairs.binary_search(&pair) {
-                    b.history[k]
-                        .as_mut_slice()
-                        .copy_from_slice(&self.history[at * lb..(at + 1) * lb]);
-                }
-            }
-        }
-    }
-
-    /// The forces of the last evaluation, over the ones a restarted procCube's first
-    /// evaluation found (call after `Cube::start`).
-    pub fn restore_forces<M: Model>(&self, cube: &mut Cube<M>) {
-        let lf = <M::Force as Attributes>::LEN;
-        let p = &mut cube.sim.particles;
-        for i in 0..p.n_owned {
-            let g = p.gid[i] as usize;
-            p.force[i]
-                .as_mut_slice()
-                .copy_from_slice(&self.force[g * lf..(g + 1) * lf]);
-        }
-    }
-
     /// What `pdq info` prints.
     pub fn describe(&self) -> String {
-        let fields = self.schema.replace('|', "; ");
+        let fields = self.state.schema.replace('|', "; ");
         format!(
             "checkpoint of model '{}' from {}\nstep       {}\ntime       {:.10e} (dt {:.6e}, {})\nparticles  {}\nattributes {}\nbonds      {} broken, {} with history\n",
-            self.model,
+            self.state.model,
             self.deck,
-            self.step,
-            self.time,
-            self.dt,
-            self.integrator,
-            self.x0.len(),
+            self.state.step,
+            self.state.time,
+            self.state.dt,
+            self.state.integrator,
+            self.state.x0.len(),
             fields,
-            self.broken.len(),
-            self.history_pairs.len()
+            self.state.broken.len(),
+            self.state.history_pairs.len()
         )
     }
 }
@@ -624,20 +464,22 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
         return Err("its bond lists name particles that do not exist or are out of order".into());
     }
     let c = Checkpoint {
-        step: attr_u64(&a, "step")?,
-        time: attr_f64(&a, "time")?,
-        dt: attr_f64(&a, "dt")?,
-        integrator: attr_string(&a, "integrator")?,
-        model: attr_string(&a, "model")?,
-        schema,
+        state: Snapshot {
+            step: attr_u64(&a, "step")?,
+            time: attr_f64(&a, "time")?,
+            dt: attr_f64(&a, "dt")?,
+            integrator: attr_string(&a, "integrator")?,
+            model: attr_string(&a, "model")?,
+            schema,
+            x0,
+            alter,
+            force,
+            broken,
+            history_pairs,
+            history,
+        },
         scene_hash: attr_u64(&a, "scene_hash")?,
         deck: attr_string(&a, "deck")?,
-        x0,
-        alter,
-        force,
-        broken,
-        history_pairs,
-        history,
     };
     if checksum(&c) != attr_u64(&a, "checksum")? {
         return Err(
@@ -711,20 +553,22 @@ mod tests {
 
     fn sample(step: u64) -> Checkpoint {
         Checkpoint {
-            step,
-            time: 1.25e-3,
-            dt: 2.5e-7,
-            integrator: "velocity-verlet".into(),
-            model: "concrete".into(),
-            schema: "pos:3,vel:3|plastic_stretch:1|force:3".into(),
+            state: Snapshot {
+                step,
+                time: 1.25e-3,
+                dt: 2.5e-7,
+                integrator: "velocity-verlet".into(),
+                model: "concrete".into(),
+                schema: "pos:3,vel:3|plastic_stretch:1|force:3".into(),
+                x0: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.5]],
+                alter: (0..18).map(|k| k as f64 * 0.1 - 0.3).collect(),
+                force: (0..9).map(|k| -(k as f64) * 1e3).collect(),
+                broken: vec![(0, 2)],
+                history_pairs: vec![(0, 1), (1, 2)],
+                history: vec![1.5e-4, -2.0e-5],
+            },
             scene_hash: 0x0123_4567_89ab_cdef,
             deck: "beam.toml".into(),
-            x0: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.5]],
-            alter: (0..18).map(|k| k as f64 * 0.1 - 0.3).collect(),
-            force: (0..9).map(|k| -(k as f64) * 1e3).collect(),
-            broken: vec![(0, 2)],
-            history_pairs: vec![(0, 1), (1, 2)],
-            history: vec![1.5e-4, -2.0e-5],
         }
     }
 
@@ -741,7 +585,7 @@ mod tests {
         kept.sort_unstable();
         assert_eq!(kept, vec![30, 40], "the newest two are kept");
         let (_, newest) = resolve(&dir).unwrap();
-        assert_eq!(newest.step, 40);
+        assert_eq!(newest.state.step, 40);
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

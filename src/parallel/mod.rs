@@ -9,6 +9,7 @@ pub mod comm_mpi;
 pub mod cube;
 pub mod decomposition;
 pub mod shuffle;
+pub mod snapshot;
 pub mod wall;
 
 pub use cube::*;

@@ -12,8 +12,8 @@
 
 use crate::input::setup::Setup;
 use crate::model::Model;
-use crate::output::checkpoint::Checkpoint;
 use crate::parallel::decomposition::{cell_plans, Layout, Walls};
+use crate::parallel::snapshot::Snapshot;
 use std::time::Instant;
 
 /// Residual of the static solve, relative to the applied forces and reactions (the implicit
@@ -25,7 +25,7 @@ const MAX_ITERATIONS: u64 = 20;
 /// The state the explicit run starts from, and what reaching it took.
 pub struct StaticStart {
     /// The state at `static_until`: step 0, time `static_until`, velocities zero.
-    pub checkpoint: Checkpoint,
+    pub state: Snapshot,
     pub evaluations: u64,
     pub residual: f64,
     /// Bonds broken by the static solve (counted in the run's damage from the start).
@@ -41,7 +41,7 @@ impl StaticStart {
     pub fn describe(&self) -> String {
         format!(
             "static     start at t = {:.4e} by the implicit solve: {} force evaluations, relative residual {:.1e}, {} bonds broken, tangent {} with {} nonzeros ({:.1} s)",
-            self.checkpoint.time,
+            self.state.time,
             self.evaluations,
             self.residual,
             self.broken,
@@ -53,14 +53,7 @@ impl StaticStart {
 }
 
 /// Solves for the static equilibrium of `setup` under its supports and loads at time `until`.
-/// `scene_hash` and `deck` label the checkpoint as a restart's would be.
-pub fn solve<M: Model>(
-    setup: &Setup<M>,
-    until: f64,
-    walls: Walls,
-    scene_hash: u64,
-    deck: &str,
-) -> Result<StaticStart, String> {
+pub fn solve<M: Model>(setup: &Setup<M>, until: f64, walls: Walls) -> Result<StaticStart, String> {
     let start = Instant::now();
     let layout = Layout::new([1, 1, 1], &setup.domain, &setup.sim.particles.x0, walls)?;
     let plans = cell_plans(&layout);
@@ -93,10 +86,10 @@ pub fn solve<M: Model>(
     cube.sim.dt = setup.sim.dt;
     cube.sim.step = 0;
     cube.sim.time = until;
-    let checkpoint = Checkpoint::gather(&mut cube, scene_hash, deck)
-        .ok_or("the static start's one procCube gathered no state")?;
+    let state =
+        Snapshot::gather(&mut cube).ok_or("the static start's one procCube gathered no state")?;
     Ok(StaticStart {
-        checkpoint,
+        state,
         evaluations: r.iterations,
         residual: r.residual,
         broken,
