@@ -7,6 +7,8 @@ use crate::input::setup::{self, Setup};
 use crate::model::{Model, ModelVisitor};
 use crate::output::checkpoint::{self, Checkpoint};
 use crate::parallel;
+#[cfg(feature = "mpi")]
+use crate::parallel::comm::Transport;
 use crate::parallel::decomposition::{Layout, Procs, Walls};
 use std::path::PathBuf;
 
