@@ -113,11 +113,7 @@ impl Model for Concrete {
         if !(factor.is_finite() && factor > 0.0) {
             return Err("model option 'interface_factor' must be > 0".into());
         }
-        let own = b
-            .materials
-            .iter()
-            .map(|m| own_law(m, b.horizon))
-            .collect::<Result<Vec<_>, _>>()?;
+        let own = b.per_material(own_law)?;
         Ok(Concrete {
             laws: PairTable::new(&own, |a, b| combine(*a, *b, factor)),
             delta: b.horizon,
@@ -229,17 +225,12 @@ fn own_law(m: &Material, delta: f64) -> Result<Law, ModelError> {
         ],
     };
     m.only_uses(used, name)?;
-    let e = m.require(
-        m.positive("youngs_modulus", Dimension::STRESS)?,
-        "youngs_modulus",
-        name,
-    )?;
+    let e = m.required("youngs_modulus", Dimension::STRESS, name)?;
     let nu = m.require(m.poisson_ratio()?, "poisson_ratio", name)?;
     let c = thesis_micromodulus(e, nu, delta);
-    let stretch = |key: &str| m.positive(key, Dimension::NUMBER);
     Ok(match m.kind {
         MaterialKind::Concrete => {
-            let tensile = m.require(stretch("tensile_stretch")?, "tensile_stretch", name)?;
+            let tensile = m.required("tensile_stretch", Dimension::NUMBER, name)?;
             let compressive = m.checked(
                 "compressive_stretch",
                 Dimension::NUMBER,
@@ -254,8 +245,9 @@ fn own_law(m: &Material, delta: f64) -> Result<Law, ModelError> {
             }
         }
         MaterialKind::Steel => {
-            let yield_ = m.require(stretch("yield_stretch")?, "yield_stretch", name)?;
-            let failure = stretch("failure_stretch")?.unwrap_or(f64::INFINITY);
+            let yield_ = m.required("yield_stretch", Dimension::NUMBER, name)?;
+            let failure = m.positive("failure_stretch", Dimension::NUMBER)?;
+            let failure = failure.unwrap_or(f64::INFINITY);
             if failure <= yield_ {
                 return Err(m.error(format!(
                     "material '{}': need 0 < yield_stretch < failure_stretch",

@@ -192,11 +192,7 @@ fn own_constants(m: &Material, delta: f64) -> Result<Own, ModelError> {
     let mut used = vec!["youngs_modulus", "poisson_ratio"];
     used.extend_from_slice(breaking);
     m.only_uses(&used, name)?;
-    let e = m.require(
-        m.positive("youngs_modulus", Dimension::STRESS)?,
-        "youngs_modulus",
-        name,
-    )?;
+    let e = m.required("youngs_modulus", Dimension::STRESS, name)?;
     let nu = m.require(m.poisson_ratio()?, "poisson_ratio", name)?;
     if nu > 0.25 + 1e-12 {
         return Err(m.error(format!(
@@ -259,11 +255,7 @@ impl Model for Micropolar {
             return Err(format!("model 'micropolar': kappa must be >= 0 (got {kappa})").into());
         }
         let delta = b.horizon;
-        let own = b
-            .materials
-            .iter()
-            .map(|m| own_constants(m, delta))
-            .collect::<Result<Vec<_>, _>>()?;
+        let own = b.per_material(own_constants)?;
         Ok(Micropolar {
             own,
             density: b.materials.iter().map(|m| m.density).collect(),

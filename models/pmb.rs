@@ -105,11 +105,7 @@ impl Model for Pmb {
 
     fn build(b: &ModelBuild) -> Result<Self, ModelError> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
-        let own = b
-            .materials
-            .iter()
-            .map(|m| Self::own_law(m, b.horizon))
-            .collect::<Result<Vec<_>, _>>()?;
+        let own = b.per_material(Self::own_law)?;
         // A bond between two materials: the series stiffness and the smaller critical stretch.
         let laws = PairTable::new(&own, |a, b| Law {
             c: 2.0 * a.c * b.c / (a.c + b.c),

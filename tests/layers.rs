@@ -189,7 +189,6 @@ const STILL_LONG: &[(&str, &str, usize)] = &[
     ("src/engine/forces.rs", "sweep", 151),
     ("src/input/deck.rs", "", 1769),
     ("src/input/deck.rs", "scene", 508),
-    ("src/input/geometry.rs", "", 870),
     ("src/input/setup.rs", "build", 332),
     ("src/lab/bench.rs", "", 779),
     ("src/lab/bench.rs", "bench_setup", 135),

@@ -37,12 +37,10 @@ fn own_law(m: &Material, delta: f64) -> Result<Law, ModelError> {
         &["youngs_modulus", "critical_stretch", "softening_stretch"],
         Softening::NAME,
     )?;
-    let e = m.positive("youngs_modulus", Dimension::STRESS)?;
-    let e = m.require(e, "youngs_modulus", Softening::NAME)?;
-    let s0 = m.positive("critical_stretch", Dimension::NUMBER)?;
-    let s0 = m.require(s0, "critical_stretch", Softening::NAME)?;
-    let sf = m.positive("softening_stretch", Dimension::NUMBER)?;
-    let sf = m.require(sf, "softening_stretch", Softening::NAME)?;
+    let name = Softening::NAME;
+    let e = m.required("youngs_modulus", Dimension::STRESS, name)?;
+    let s0 = m.required("critical_stretch", Dimension::NUMBER, name)?;
+    let sf = m.required("softening_stretch", Dimension::NUMBER, name)?;
     if sf <= s0 {
         return Err(m.key_error(
             "softening_stretch",
@@ -71,11 +69,7 @@ impl Model for Softening {
 
     fn build(b: &ModelBuild) -> Result<Self, ModelError> {
         check_options(Self::NAME, Self::OPTIONS, b.options)?;
-        let own = b
-            .materials
-            .iter()
-            .map(|m| own_law(m, b.horizon))
-            .collect::<Result<Vec<_>, _>>()?;
+        let own = b.per_material(own_law)?;
         Ok(Softening {
             laws: PairTable::new(&own, |a, b| Law {
                 c: a.c.min(b.c),

@@ -433,11 +433,13 @@ impl Cloud {
 }
 
 /// `message` is the complete user-facing text; `entry`/`bar` let callers point at the deck line.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct GeometryError {
     /// Index into ops (Some) or None for the whole scene.
     pub entry: Option<usize>,
     pub bar: Option<usize>,
+    /// The scene came out empty: nothing was added, or every site was subtracted.
+    pub empty: bool,
     pub message: String,
 }
 
@@ -451,9 +453,8 @@ impl std::error::Error for GeometryError {}
 
 fn scene_err(message: String) -> GeometryError {
     GeometryError {
-        entry: None,
-        bar: None,
         message,
+        ..Default::default()
     }
 }
 
@@ -500,8 +501,8 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
         let kind = shape.kind();
         let err = |m: &str| GeometryError {
             entry: Some(n),
-            bar: None,
             message: format!("geometry entry {n} ({kind}){m}"),
+            ..Default::default()
         };
         shape.validate().map_err(|m| err(&format!(": {m}")))?;
         let Op::Add { material, .. } = op else {
@@ -524,8 +525,9 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
             selected += 1;
         }
         if selected == 0 {
-            let m = " selects no lattice site: it is smaller than the spacing or outside";
-            return Err(err(m));
+            return Err(err(
+                " selects no lattice site: it is smaller than the spacing or outside",
+            ));
         }
     }
 
@@ -533,9 +535,9 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
     for (b, bar) in bars.iter().enumerate() {
         let message = |m| format!("bar {b}: {m}");
         let err = |m| GeometryError {
-            entry: None,
             bar: Some(b),
             message: message(m),
+            ..Default::default()
         };
         bar.validate().map_err(err)?;
         total += bar.count();
@@ -582,289 +584,14 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
     }
     if cloud.is_empty() {
         let m = "the scene has no particles: nothing was added, or every site was subtracted";
-        return Err(scene_err(m.into()));
+        return Err(GeometryError {
+            empty: true,
+            ..scene_err(m.into())
+        });
     }
     Ok(cloud)
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn run(s: f64, ops: &[Op], bars: &[Bar]) -> Result<Cloud, GeometryError> {
-        build(&Lattice::regular(s, [0.0; 3]), ops, bars)
-    }
-    fn add(shape: Shape, material: u16) -> Op {
-        Op::Add { shape, material }
-    }
-    fn bx(min: Vec3, max: Vec3) -> Shape {
-        Shape::Box { min, max }
-    }
-    fn cube(a: f64, b: f64) -> Shape {
-        bx([a; 3], [b; 3])
-    }
-    fn prism(axis: usize, polygon: Vec<[f64; 2]>) -> Shape {
-        Shape::Prism {
-            axis,
-            polygon,
-            from: 1.0,
-            to: 6.0,
-        }
-    }
-    fn cyl(base: Vec3, axis: Vec3, length: f64, radius: f64) -> Shape {
-        Shape::Cylinder {
-            base,
-            axis,
-            length,
-            radius,
-        }
-    }
-    fn x_bar(from: Vec3, length: f64, area: f64, spacing: f64) -> Bar {
-        Bar::along(from, [1.0, 0.0, 0.0], length, area, spacing, 9)
-    }
-
-    #[test]
-    fn jitter_moves_sites_within_bound_and_repeats_with_its_seed() {
-        let ops = [add(bx([0.0; 3], [10.0, 10.0, 10.0]), 0)];
-        let lattice = |seed| Lattice {
-            jitter: 0.2,
-            seed,
-            ..Lattice::regular(1.0, [0.0; 3])
-        };
-        let regular = run(1.0, &ops, &[]).unwrap();
-        let a = build(&lattice(1), &ops, &[]).unwrap();
-        let b = build(&lattice(1), &ops, &[]).unwrap();
-        let c = build(&lattice(2), &ops, &[]).unwrap();
-        assert_eq!(a.position, b.position);
-        assert_ne!(a.position, c.position);
-        let mut largest: f64 = 0.0;
-        for (p, q) in a.position.iter().zip(&regular.position) {
-            for e in 0..3 {
-                largest = largest.max((p[e] - q[e]).abs());
-            }
-        }
-        // 3000 draws from U(−0.2, 0.2): the largest is within 1 % of the bound.
-        assert!(largest <= 0.2 && largest > 0.19, "largest offset {largest}");
-        let err = build(
-            &Lattice {
-                jitter: 0.5,
-                ..lattice(1)
-            },
-            &ops,
-            &[],
-        )
-        .unwrap_err();
-        assert!(err.to_string().contains("jitter"), "{err}");
-    }
-
-    #[test]
-    fn box_300k_exact_and_ordered() {
-        let c = run(1.0, &[add(bx([0.0; 3], [200.0, 50.0, 30.0]), 7)], &[]).unwrap();
-        assert_eq!(c.len(), 300_000);
-        assert!(c.volume.iter().chain(&c.spacing).all(|&v| v == 1.0));
-        assert!(c.material.iter().all(|&m| m == 7));
-        let at = |n: usize| c.position[n];
-        assert_eq!(
-            [at(0), at(1), at(200)],
-            [[0.5; 3], [1.5, 0.5, 0.5], [0.5, 1.5, 0.5]]
-        );
-        assert_eq!(
-            [at(10_000), at(299_999)],
-            [[0.5, 0.5, 1.5], [199.5, 49.5, 29.5]]
-        );
-    }
-
-    #[test]
-    fn box_minus_box() {
-        let c = run(
-            1.0,
-            &[
-                add(cube(0.0, 10.0), 1),
-                Op::Subtract {
-                    shape: cube(3.0, 7.0),
-                },
-            ],
-            &[],
-        );
-        assert_eq!(c.unwrap().len(), 1000 - 64);
-    }
-
-    #[test]
-    fn cylinder_along_x_matches_brute_force() {
-        let c = run(
-            1.0,
-            &[add(cyl([0.0; 3], [2.0, 0.0, 0.0], 12.0, 3.0), 1)],
-            &[],
-        )
-        .unwrap();
-        let h = |n: i32| n as f64 + 0.5;
-        let brute = (-20..20)
-            .flat_map(|i| (-20..20).flat_map(move |j| (-20..20).map(move |k| (h(i), h(j), h(k)))))
-            .filter(|&(x, y, z)| (0.0..=12.0).contains(&x) && y * y + z * z <= 9.0)
-            .count();
-        assert_eq!((c.len(), brute), (12 * 32, 12 * 32));
-    }
-
-    #[test]
-    fn oblique_cylinder_inside() {
-        let (base, axis, len, r, s) = ([1.0, 2.0, 3.0], [1.0, 1.0, 1.0], 10.0, 2.5, 0.5);
-        let c = run(s, &[add(cyl(base, axis, len, r), 1)], &[]).unwrap();
-        for p in &c.position {
-            let (d, a) = (sub(*p, base), normalize(axis));
-            let t = dot(d, a);
-            assert!((-1e-9..=len + 1e-9).contains(&t) && dot(d, d) - t * t <= r * r + 1e-9);
-        }
-        let expected = std::f64::consts::PI * r * r * len / (s * s * s);
-        assert!(
-            (c.len() as f64 - expected).abs() < 0.05 * expected,
-            "{}",
-            c.len()
-        );
-    }
-
-    #[test]
-    fn prism_square_equals_box_on_every_axis() {
-        let poly = vec![[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]];
-        let boxes = [
-            [1.0, 0.0, 0.0, 6.0, 4.0, 3.0],
-            [0.0, 1.0, 0.0, 3.0, 6.0, 4.0],
-        ];
-        let boxes = [boxes[0], boxes[1], [0.0, 0.0, 1.0, 4.0, 3.0, 6.0]];
-        for (axis, b) in boxes.into_iter().enumerate() {
-            let p = run(0.5, &[add(prism(axis, poly.clone()), 1)], &[]).unwrap();
-            let b = run(
-                0.5,
-                &[add(bx([b[0], b[1], b[2]], [b[3], b[4], b[5]]), 1)],
-                &[],
-            );
-            assert_eq!((p.len(), &p), (480, &b.unwrap()), "axis {axis}");
-        }
-    }
-
-    #[test]
-    fn prism_l_shape_and_orientation() {
-        let mut poly = vec![
-            [0.0, 0.0],
-            [6.0, 0.0],
-            [6.0, 2.0],
-            [2.0, 2.0],
-            [2.0, 5.0],
-            [0.0, 5.0],
-        ];
-        let ccw = run(1.0, &[add(prism(2, poly.clone()), 1)], &[]).unwrap();
-        assert_eq!(ccw.len(), (12 + 6) * 5);
-        assert!(!ccw.position.iter().any(|p| p[0] > 2.0 && p[1] > 2.0));
-        poly.reverse();
-        assert_eq!(run(1.0, &[add(prism(2, poly), 1)], &[]).unwrap(), ccw);
-    }
-
-    #[test]
-    fn later_add_wins_and_subtract_then_add_restores() {
-        let c = run(1.0, &[add(cube(0.0, 10.0), 1), add(cube(2.0, 4.0), 2)], &[]).unwrap();
-        assert_eq!(
-            (c.len(), c.material.iter().filter(|&&m| m == 2).count()),
-            (1000, 8)
-        );
-        let plain = run(1.0, &[add(cube(0.0, 10.0), 1)], &[]).unwrap();
-        let hole = Op::Subtract {
-            shape: cube(2.0, 5.0),
-        };
-        let ops = [add(cube(0.0, 10.0), 1), hole, add(cube(2.0, 5.0), 1)];
-        assert_eq!(run(1.0, &ops, &[]).unwrap(), plain);
-    }
-
-    #[test]
-    fn slab_is_half_open_and_only_subtracts() {
-        let slab = Shape::Slab {
-            axis: 2,
-            from: 0.0,
-            to: 2.5,
-        };
-        assert!(slab.contains([9.0, 9.0, 0.0]) && !slab.contains([9.0, 9.0, 2.5]));
-        let ops = [
-            add(cube(0.0, 10.0), 1),
-            Op::Subtract {
-                shape: slab.clone(),
-            },
-        ];
-        assert_eq!(run(0.5, &ops, &[]).unwrap().len(), 8000 - 400 * 5);
-        let e = run(1.0, &[add(slab, 1)], &[]).unwrap_err();
-        assert!(e.message.contains("slab is unbounded"), "{e}");
-    }
-
-    #[test]
-    fn bar_particles() {
-        let bar = Bar::along([1.0, 2.0, 3.0], [0.0, 0.0, 2.0], 10.0, 0.2, 0.5, 3);
-        let c = run(1.0, &[], &[bar]).unwrap();
-        assert_eq!(c.len(), 20);
-        for (k, p) in c.position.iter().enumerate() {
-            assert_eq!(*p, [1.0, 2.0, 3.0 + 0.5 * (k as f64 + 0.5)]);
-        }
-        assert!(c.volume.iter().all(|&v| (v - 0.1).abs() < 1e-15));
-        assert!(c.material.iter().all(|&m| m == 3) && c.spacing.iter().all(|&d| d == 0.5));
-        let close = |a: Vec3, b: Vec3| (0..3).all(|e| (a[e] - b[e]).abs() < 1e-12);
-        let angled = |az, el| Bar::at_angle([0.0; 3], az, el, 2.0, 1.0, 1.0, 0).to;
-        assert!(close(angled(0.0, 90.0), [0.0, 0.0, 2.0]));
-        assert!(close(angled(90.0, 0.0), [0.0, 2.0, 0.0]));
-        assert!(close(angled(180.0, 0.0), [-2.0, 0.0, 0.0]));
-    }
-
-    #[test]
-    fn bar_removes_only_coincident_sites() {
-        let ops = [add(cube(0.0, 10.0), 1)];
-        let c = run(1.0, &ops, &[x_bar([0.0, 5.5, 5.5], 10.0, 0.1, 1.0)]).unwrap();
-        assert_eq!(c.len(), 1000 - 10 + 10);
-        assert_eq!(c.material.iter().filter(|&&m| m == 9).count(), 10);
-        assert!(c.position.contains(&[3.5, 4.5, 5.5]) && c.position.contains(&[3.5, 5.5, 6.5]));
-        // A bar between site rows, or with particles between sites, removes nothing.
-        let c = run(1.0, &ops, &[x_bar([0.0, 5.0, 5.0], 10.0, 0.1, 1.0)]).unwrap();
-        assert_eq!(c.len(), 1010);
-        let c = run(1.0, &ops, &[x_bar([0.5, 5.5, 5.5], 9.0, 0.1, 1.0)]).unwrap();
-        assert_eq!(c.len(), 1009);
-    }
-
-    #[test]
-    fn errors() {
-        let bad = cyl([0.0; 3], [1.0, 0.0, 0.0], 1.0, -1.0);
-        assert_eq!(
-            bad.validate().unwrap_err(),
-            "cylinder radius must be > 0 (got -1)"
-        );
-        let e = run(1.0, &[add(cube(0.0, 9.0), 1), add(bad, 1)], &[]).unwrap_err();
-        assert_eq!((e.entry, e.bar), (Some(1), None));
-        let msg = "geometry entry 1 (cylinder): cylinder radius must be > 0 (got -1)";
-        assert_eq!(e.to_string(), msg);
-        let e = prism(2, vec![]).validate().unwrap_err();
-        assert!(e.contains("at least 3 vertices"), "{e}");
-        let e = prism(2, vec![[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]])
-            .validate()
-            .unwrap_err();
-        assert!(e.contains("zero area"), "{e}");
-        let ops = [
-            add(cube(0.0, 9.0), 1),
-            add(cube(0.0, 9.0), 1),
-            add(cube(0.1, 0.2), 1),
-        ];
-        let msg = "geometry entry 2 (box) selects no lattice site: it is smaller than the spacing or outside";
-        assert_eq!(run(1.0, &ops, &[]).unwrap_err().message, msg);
-        let ops = [
-            add(cube(0.0, 4.0), 1),
-            Op::Subtract {
-                shape: cube(-1.0, 5.0),
-            },
-        ];
-        let e = run(1.0, &ops, &[]).unwrap_err();
-        assert!(
-            e.entry.is_none() && e.message.contains("no particles"),
-            "{e}"
-        );
-        let e = run(0.0, &ops[..1], &[]).unwrap_err();
-        assert!(e.entry.is_none() && e.message.contains("spacing"), "{e}");
-        let bad = x_bar([0.0; 3], 1.0, 0.0, 1.0);
-        let e = run(1.0, &ops[..1], &[bad.clone(), bad]).unwrap_err();
-        assert_eq!((e.entry, e.bar), (None, Some(0)));
-        assert!(e.message.contains("area"), "{e}");
-        let e = run(1.0, &[add(cube(0.0, 1e9), 1)], &[]).unwrap_err();
-        assert!(e.message.contains("u32::MAX"), "{e}");
-    }
-}
+#[path = "geometry_tests.rs"]
+mod tests;

@@ -97,15 +97,12 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     let start = Instant::now();
     let cloud = geometry::build(&scene.lattice, &scene.ops, &scene.bars).map_err(|e| {
         // An empty scene is blamed on the last subtraction, the usual culprit.
-        let last_subtract = (e.message.contains("no particles"))
-            .then(|| {
-                scene
-                    .ops
-                    .iter()
-                    .rposition(|o| matches!(o, geometry::Op::Subtract { .. }))
-                    .map(|k| scene.op_lines[k])
-            })
-            .flatten();
+        let subtract = |o: &geometry::Op| e.empty && matches!(o, geometry::Op::Subtract { .. });
+        let last_subtract = scene
+            .ops
+            .iter()
+            .rposition(subtract)
+            .map(|k| scene.op_lines[k]);
         let line = e
             .entry
             .map(|k| scene.op_lines[k])

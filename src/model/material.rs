@@ -266,6 +266,12 @@ impl Material {
         })
     }
 
+    /// A quantity the model cannot do without, > 0.
+    pub fn required(&self, key: &str, dim: Dimension, model: &str) -> Result<f64, ModelError> {
+        let value = self.positive(key, dim)?;
+        self.require(value, key, model)
+    }
+
     /// Exactly one of `keys` (each > 0, of its dimension): its position in `keys` and value.
     /// None given, or several, is refused with `needs` as the remedy.
     pub fn one_of(

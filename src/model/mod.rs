@@ -33,6 +33,18 @@ pub struct ModelBuild<'a> {
 }
 
 impl ModelBuild<'_> {
+    /// Each material's own constants, in material order, from `own(material, horizon)`; the
+    /// first error stops.
+    pub fn per_material<T>(
+        &self,
+        own: impl Fn(&Material, f64) -> Result<T, ModelError>,
+    ) -> Result<Vec<T>, ModelError> {
+        self.materials
+            .iter()
+            .map(|m| own(m, self.horizon))
+            .collect()
+    }
+
     fn value(&self, name: &str) -> Option<&OptionValue> {
         self.options.iter().find(|(k, _)| k == name).map(|(_, v)| v)
     }
