@@ -180,16 +180,16 @@ fn long_functions(text: &str) -> Vec<(usize, usize, String)> {
     out
 }
 
-/// What was still over those sizes when the limits were set, at most as long as it was then:
+/// What is still over those sizes, at most as long as it is now (tightened as items shrink):
 /// (file under the crate root, function or "" for the file itself, lines). Splitting one
 /// removes it from here; the test fails if one grows, if a new one appears, or if a listed
 /// one has been brought within the limit and is still listed.
 const STILL_LONG: &[(&str, &str, usize)] = &[
-    ("src/driver/run.rs", "run_setup", 200),
+    ("src/driver/run.rs", "run_setup", 169),
     ("src/engine/forces.rs", "sweep", 151),
-    ("src/input/deck.rs", "", 1769),
-    ("src/input/deck.rs", "scene", 508),
-    ("src/input/setup.rs", "build", 332),
+    ("src/input/deck.rs", "", 1698),
+    ("src/input/deck.rs", "scene", 492),
+    ("src/input/setup.rs", "build", 329),
     ("src/lab/bench.rs", "", 779),
     ("src/lab/bench.rs", "bench_setup", 135),
     ("src/lab/stress.rs", "", 771),
