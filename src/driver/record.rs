@@ -2,7 +2,7 @@
 //! the final state by global id.
 
 use super::run::Summary;
-use super::step_loop::Plan;
+use super::step_loop::{Plan, Tally};
 use crate::engine::particles::Particles;
 use crate::engine::timing::Phase;
 use crate::input::deck::SolverSpec;
@@ -313,15 +313,17 @@ pub(crate) fn balance_table(rows: &[Vec<f64>], steps: u64) -> String {
 }
 
 /// The end of a run on every worker: totals reduced, the final positions, damage and broken
-/// bonds gathered by global id, each procCube's share of the time; the root completes
-/// `summary` with them, writes `timing.txt` (and the final state if asked) and returns it.
+/// bonds gathered by global id, each procCube's share of the time; the root writes
+/// `timing.txt` (and the final state if asked) and returns the summary, with what the loop
+/// counted (`tally`) and its wall time.
 pub(crate) fn finish<M: Model>(
     mut cube: Cube<M>,
     plan: &Plan,
     mut history: Option<History>,
-    mut summary: Summary,
+    tally: Tally,
+    seconds: f64,
 ) -> Result<Option<Summary>, String> {
-    let io = |e: std::io::Error| format!("writing output in {}: {e}", plan.dir.display());
+    let io = |e| plan.io(e);
     let n_global = cube.global_particles;
     let mut totals = [
         (cube.sim.bonds.len() + cube.dropped.len()) as f64,
@@ -344,8 +346,8 @@ pub(crate) fn finish<M: Model>(
         totals[0] as usize,
         totals[1] as usize,
         plan.layout,
-        if summary.shuffles > 0 {
-            format!(", {} shuffles moved particles", summary.shuffles)
+        if tally.shuffles > 0 {
+            format!(", {} shuffles moved particles", tally.shuffles)
         } else {
             String::new()
         }
@@ -360,27 +362,39 @@ pub(crate) fn finish<M: Model>(
     if plan.final_state {
         write_final_state(&plan.dir, &position, &damage, &broken_pairs).map_err(io)?;
     }
-    if let Some((_, size, secs)) = summary.checkpoints.last() {
+    if let Some((_, size, secs)) = tally.checkpoints.last() {
         let _ = writeln!(
             timing,
             "checkpoints: {} written, the last {:.1} MB in {:.3} s",
-            summary.checkpoints.len(),
+            tally.checkpoints.len(),
             *size as f64 / 1e6,
             secs
         );
     }
-    summary.particles = n_global;
-    summary.bonds = totals[0] as usize;
-    summary.steps = cube.sim.step;
-    summary.dt = cube.sim.dt;
-    summary.broken = totals[1] as usize;
-    summary.kinetic_energy = totals[2];
-    summary.strain_energy = totals[3];
-    summary.timing = timing;
-    summary.positions = position;
-    summary.damage = damage;
-    summary.broken_pairs = broken_pairs;
-    Ok(Some(summary))
+    Ok(Some(Summary {
+        particles: n_global,
+        bonds: totals[0] as usize,
+        steps: cube.sim.step,
+        dt: cube.sim.dt,
+        broken: totals[1] as usize,
+        kinetic_energy: totals[2],
+        strain_energy: totals[3],
+        output: plan.dir.clone(),
+        seconds,
+        timing,
+        layout: plan.layout.clone(),
+        shuffles: tally.shuffles,
+        positions: position,
+        damage,
+        broken_pairs,
+        interrupted: tally.interrupted,
+        checkpoints: tally.checkpoints,
+        first_step: plan.first_step,
+        force_evaluations: tally.evaluations,
+        converged_steps: tally.converged,
+        stopped_at_broken: tally.stopped_at_broken,
+        stopped_at_probe: tally.stopped_at_probe,
+    }))
 }
 
 /// Current positions and damage by global id, on the root (empty elsewhere).

@@ -216,18 +216,18 @@ impl SolverChoice {
 
 /// What the loop counts on the way, for the summary.
 #[derive(Default)]
-struct Tally {
-    evaluations: u64,
-    converged: u64,
+pub(crate) struct Tally {
+    pub evaluations: u64,
+    pub converged: u64,
     /// The last load step's solve (quasi-static solvers).
-    solved: Option<Relaxed>,
+    pub solved: Option<Relaxed>,
     /// Broken bonds at the last history row.
-    broken: usize,
-    shuffles: u64,
-    stopped_at_broken: bool,
-    stopped_at_probe: Option<String>,
-    interrupted: Option<PathBuf>,
-    checkpoints: Vec<(PathBuf, u64, f64)>,
+    pub broken: usize,
+    pub shuffles: u64,
+    pub stopped_at_broken: bool,
+    pub stopped_at_probe: Option<String>,
+    pub interrupted: Option<PathBuf>,
+    pub checkpoints: Vec<(PathBuf, u64, f64)>,
 }
 
 /// The root's history and frame files, and the first error writing them: kept until every
@@ -285,7 +285,7 @@ impl Files {
 }
 
 impl Plan {
-    fn io(&self, e: std::io::Error) -> String {
+    pub fn io(&self, e: std::io::Error) -> String {
         format!("writing output in {}: {e}", self.dir.display())
     }
 }
@@ -338,7 +338,7 @@ pub(crate) fn drive<M: Model>(
     }
     files.agree(&mut cube)?;
     let seconds = wall.elapsed().as_secs_f64();
-    super::record::finish(cube, plan, files.history, tally.into_summary(plan, seconds))
+    super::record::finish(cube, plan, files.history, tally, seconds)
 }
 
 /// Restores a checkpoint's bonds, makes the bond counts whole, computes the first forces.
@@ -520,35 +520,5 @@ impl CheckpointClock {
             );
         }
         Ok(stop)
-    }
-}
-
-impl Tally {
-    /// The summary's counts; `finish` adds the totals and the final state.
-    fn into_summary(self, plan: &Plan, seconds: f64) -> Summary {
-        Summary {
-            particles: 0,
-            bonds: 0,
-            steps: 0,
-            dt: 0.0,
-            broken: 0,
-            kinetic_energy: 0.0,
-            strain_energy: 0.0,
-            output: plan.dir.clone(),
-            seconds,
-            timing: String::new(),
-            layout: plan.layout.clone(),
-            shuffles: self.shuffles,
-            positions: Vec::new(),
-            damage: Vec::new(),
-            broken_pairs: Vec::new(),
-            interrupted: self.interrupted,
-            checkpoints: self.checkpoints,
-            first_step: plan.first_step,
-            force_evaluations: self.evaluations,
-            converged_steps: self.converged,
-            stopped_at_broken: self.stopped_at_broken,
-            stopped_at_probe: self.stopped_at_probe,
-        }
     }
 }

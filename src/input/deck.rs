@@ -572,11 +572,7 @@ impl Converter {
     }
 
     fn err<T>(&self, line: usize, message: impl Into<String>) -> R<T> {
-        Err(DeckError {
-            file: self.file.clone(),
-            line: Some(line),
-            message: message.into(),
-        })
+        Err(self.error_at(line, message.into()))
     }
 
     fn line_of<T>(&self, s: &Spanned<T>) -> usize {
