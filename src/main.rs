@@ -1,6 +1,6 @@
 //! The `pdq` command line.
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use pdq::driver::run;
 use pdq::input::deck;
 use pdq::lab::bench;
@@ -21,98 +21,12 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run a deck: time history, frames and a timing table in the output directory.
-    Run {
-        deck: PathBuf,
-        /// Run this many steps instead of the deck's.
-        #[arg(long)]
-        steps: Option<u64>,
-        /// Write output here instead of the deck's directory.
-        #[arg(long)]
-        output: Option<PathBuf>,
-        /// Print nothing but errors.
-        #[arg(long)]
-        quiet: bool,
-        /// Worker threads, one procCube each (not under mpirun, where each rank is one).
-        #[arg(long)]
-        threads: Option<usize>,
-        /// ProcCubes along x, y and z, as NXxNYxNZ (e.g. 2x2x1), or "auto".
-        #[arg(long, value_parser = parse_procs)]
-        procs: Option<pdq::parallel::decomposition::Procs>,
-        /// Ghost messages: "whole" walls or "trimmed" to the cells each neighbour needs.
-        #[arg(long, value_parser = parse_walls)]
-        walls: Option<pdq::parallel::decomposition::Walls>,
-        /// Resume from a checkpoint file, or from the newest readable checkpoint in a
-        /// directory (an output directory or its checkpoints/).
-        #[arg(long)]
-        restart: Option<PathBuf>,
-    },
+    Run(RunArgs),
     /// Run the validation cases against engineering formulas; write report.md.
-    Validate {
-        /// Coarse versions of every case (the default).
-        #[arg(long, conflicts_with = "full")]
-        quick: bool,
-        /// The finer resolution.
-        #[arg(long)]
-        full: bool,
-        /// Cases to run (all when none is named).
-        cases: Vec<String>,
-        /// Output directory.
-        #[arg(long, default_value = "out/validate")]
-        output: PathBuf,
-        /// Threads per explicit or ADR case (default: the cores available; the implicit solve
-        /// runs on one).
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Instead of the cases: ADR against an explicit load ramp on the LPS cantilever
-        /// (force evaluations to the same residual).
-        #[arg(long)]
-        compare_adr: bool,
-        /// With --compare-adr: the explicit run ramps the load over this many periods of the
-        /// first bending mode (then holds it for three); a longer ramp leaves less vibration.
-        #[arg(long, default_value_t = 5.0)]
-        ramp_periods: f64,
-        /// Quasi-static solver of the elastic cases: "implicit" (Newton with the assembled
-        /// tangent, one thread; the same answers as ADR in a fraction of the time) or "adr".
-        /// Default: implicit with --quick, adr with --full (the factored tangent of the full
-        /// micropolar beam outgrows 24 GiB).
-        #[arg(long, value_parser = ["adr", "implicit"])]
-        solver: Option<String>,
-        /// Instead of the cases: the elastic cantilever swept over resolution, m and solver;
-        /// error against run time (sweep.md, sweep.png).
-        #[arg(long)]
-        sweep: bool,
-        /// Sweep: models, comma-separated.
-        #[arg(long, value_delimiter = ',', default_value = "pmb,lps")]
-        models: Vec<String>,
-        /// Sweep: lattice planes across the section (odd), comma-separated.
-        #[arg(long, value_delimiter = ',', default_value = "5,7,9")]
-        planes: Vec<usize>,
-        /// Sweep: horizon ratios m, comma-separated.
-        #[arg(long, value_delimiter = ',', default_value = "2,3,4")]
-        m: Vec<f64>,
-        /// Sweep: solvers, comma-separated (implicit, adr).
-        #[arg(long, value_delimiter = ',', default_value = "implicit")]
-        solvers: Vec<String>,
-    },
+    Validate(ValidateArgs),
     /// Numerical stability stress tests: critical time step against the bound, energy drift,
     /// sudden failure (docs/stability.md).
-    Stress {
-        /// Smaller and shorter runs (about a minute).
-        #[arg(long)]
-        quick: bool,
-        /// Sections to run, comma-separated: dt, drift, failure (default all).
-        #[arg(long, value_delimiter = ',')]
-        sections: Vec<String>,
-        /// Models to run, comma-separated (default all).
-        #[arg(long, value_delimiter = ',')]
-        models: Vec<String>,
-        /// Cases run side by side.
-        #[arg(long, default_value_t = 2)]
-        threads: usize,
-        /// Also write the report to this file.
-        #[arg(long)]
-        output: Option<PathBuf>,
-    },
+    Stress(StressArgs),
     /// Print what a frame or checkpoint file holds: step, time, particles, attributes, bonds.
     Info { file: PathBuf },
     /// Check a deck: particles, bonds, memory, time step, and an estimated run time.
@@ -120,47 +34,148 @@ enum Cmd {
     /// List the models and the attributes each declares.
     Models,
     /// Time the standard benchmark scene (shared/bench): µs per particle-step.
-    Bench {
-        #[arg(long, default_value = "pmb")]
-        model: String,
-        /// Thread counts to time, comma-separated (one procCube per thread).
-        #[arg(long, value_delimiter = ',', default_value = "1,2")]
-        threads: Vec<usize>,
-        /// MPI rank counts to time through mpirun, comma-separated (needs the `mpi` feature;
-        /// default 1,2 in an MPI build, none otherwise).
-        #[arg(long, value_delimiter = ',')]
-        ranks: Vec<usize>,
-        /// Ghost messages: whole walls or trimmed.
-        #[arg(long, value_parser = parse_walls, default_value = "whole")]
-        walls: pdq::parallel::decomposition::Walls,
-        /// ProcCubes as NXxNYxNZ for every thread count (default: chosen per count).
-        #[arg(long, value_parser = parse_procs)]
-        procs: Option<pdq::parallel::decomposition::Procs>,
-        /// Skip the generic-against-hand-written force pass comparison.
-        #[arg(long)]
-        no_yardstick: bool,
-        #[arg(long, default_value_t = 200)]
-        steps: u64,
-        /// Lattice cells per edge ((n+1)³ particles); 40 is the standard scene.
-        #[arg(long, default_value_t = 40)]
-        n: usize,
-        /// Also run LAMMPS (`lmp`, or $PDQ_LMP) on the same scene.
-        #[arg(long)]
-        peer: bool,
-        /// Repetitions of the generic-vs-hand force pass comparison.
-        #[arg(long, default_value_t = 7)]
-        repeat: usize,
-        /// Times through the thread counts, alternating; medians are printed when above 1.
-        #[arg(long, default_value_t = 1)]
-        rounds: usize,
-        /// Also time writing a checkpoint of the scene against 100 steps (one thread).
-        #[arg(long)]
-        checkpoint: bool,
-        /// Instead: the scene with and without each feature a deck may leave out (damage
-        /// checks, state pass, rotations, shuffling), `--rounds` times; prints a table.
-        #[arg(long)]
-        savings: bool,
-    },
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+struct RunArgs {
+    deck: PathBuf,
+    /// Run this many steps instead of the deck's.
+    #[arg(long)]
+    steps: Option<u64>,
+    /// Write output here instead of the deck's directory.
+    #[arg(long)]
+    output: Option<PathBuf>,
+    /// Print nothing but errors.
+    #[arg(long)]
+    quiet: bool,
+    /// Worker threads, one procCube each (not under mpirun, where each rank is one).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// ProcCubes along x, y and z, as NXxNYxNZ (e.g. 2x2x1), or "auto".
+    #[arg(long, value_parser = parse_procs)]
+    procs: Option<pdq::parallel::decomposition::Procs>,
+    /// Ghost messages: "whole" walls or "trimmed" to the cells each neighbour needs.
+    #[arg(long, value_parser = parse_walls)]
+    walls: Option<pdq::parallel::decomposition::Walls>,
+    /// Resume from a checkpoint file, or from the newest readable checkpoint in a
+    /// directory (an output directory or its checkpoints/).
+    #[arg(long)]
+    restart: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct ValidateArgs {
+    /// Coarse versions of every case (the default).
+    #[arg(long, conflicts_with = "full")]
+    quick: bool,
+    /// The finer resolution.
+    #[arg(long)]
+    full: bool,
+    /// Cases to run (all when none is named).
+    cases: Vec<String>,
+    /// The directory of the case files (NAME.toml and suite.toml; validation/README.md).
+    #[arg(long, default_value = "validation")]
+    case_dir: PathBuf,
+    /// Output directory.
+    #[arg(long, default_value = "out/validate")]
+    output: PathBuf,
+    /// Threads per explicit or ADR case (default: the cores available; the implicit solve
+    /// runs on one).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Instead of the cases: ADR against an explicit load ramp on the LPS cantilever
+    /// (force evaluations to the same residual).
+    #[arg(long)]
+    compare_adr: bool,
+    /// With --compare-adr: the explicit run ramps the load over this many periods of the
+    /// first bending mode (then holds it for three); a longer ramp leaves less vibration.
+    #[arg(long, default_value_t = 5.0)]
+    ramp_periods: f64,
+    /// Quasi-static solver of the elastic cases: "implicit" (Newton with the assembled
+    /// tangent, one thread; the same answers as ADR in a fraction of the time) or "adr".
+    /// Default: implicit with --quick, adr with --full (the factored tangent of the full
+    /// micropolar beam outgrows 24 GiB).
+    #[arg(long, value_parser = ["adr", "implicit"])]
+    solver: Option<String>,
+    /// Instead of the cases: the elastic cantilever swept over resolution, m and solver;
+    /// error against run time (sweep.md, sweep.png).
+    #[arg(long)]
+    sweep: bool,
+    /// Sweep: models, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "pmb,lps")]
+    models: Vec<String>,
+    /// Sweep: lattice planes across the section (odd), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "5,7,9")]
+    planes: Vec<usize>,
+    /// Sweep: horizon ratios m, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "2,3,4")]
+    m: Vec<f64>,
+    /// Sweep: solvers, comma-separated (implicit, adr).
+    #[arg(long, value_delimiter = ',', default_value = "implicit")]
+    solvers: Vec<String>,
+}
+
+#[derive(Args)]
+struct StressArgs {
+    /// Smaller and shorter runs (about a minute).
+    #[arg(long)]
+    quick: bool,
+    /// Sections to run, comma-separated: dt, drift, failure (default all).
+    #[arg(long, value_delimiter = ',')]
+    sections: Vec<String>,
+    /// Models to run, comma-separated (default all).
+    #[arg(long, value_delimiter = ',')]
+    models: Vec<String>,
+    /// Cases run side by side.
+    #[arg(long, default_value_t = 2)]
+    threads: usize,
+    /// Also write the report to this file.
+    #[arg(long)]
+    output: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    #[arg(long, default_value = "pmb")]
+    model: String,
+    /// Thread counts to time, comma-separated (one procCube per thread).
+    #[arg(long, value_delimiter = ',', default_value = "1,2")]
+    threads: Vec<usize>,
+    /// MPI rank counts to time through mpirun, comma-separated (needs the `mpi` feature;
+    /// default 1,2 in an MPI build, none otherwise).
+    #[arg(long, value_delimiter = ',')]
+    ranks: Vec<usize>,
+    /// Ghost messages: whole walls or trimmed.
+    #[arg(long, value_parser = parse_walls, default_value = "whole")]
+    walls: pdq::parallel::decomposition::Walls,
+    /// ProcCubes as NXxNYxNZ for every thread count (default: chosen per count).
+    #[arg(long, value_parser = parse_procs)]
+    procs: Option<pdq::parallel::decomposition::Procs>,
+    /// Skip the generic-against-hand-written force pass comparison.
+    #[arg(long)]
+    no_yardstick: bool,
+    #[arg(long, default_value_t = 200)]
+    steps: u64,
+    /// Lattice cells per edge ((n+1)³ particles); 40 is the standard scene.
+    #[arg(long, default_value_t = 40)]
+    n: usize,
+    /// Also run LAMMPS (`lmp`, or $PDQ_LMP) on the same scene.
+    #[arg(long)]
+    peer: bool,
+    /// Repetitions of the generic-vs-hand force pass comparison.
+    #[arg(long, default_value_t = 7)]
+    repeat: usize,
+    /// Times through the thread counts, alternating; medians are printed when above 1.
+    #[arg(long, default_value_t = 1)]
+    rounds: usize,
+    /// Also time writing a checkpoint of the scene against 100 steps (one thread).
+    #[arg(long)]
+    checkpoint: bool,
+    /// Instead: the scene with and without each feature a deck may leave out (damage
+    /// checks, state pass, rotations, shuffling), `--rounds` times; prints a table.
+    #[arg(long)]
+    savings: bool,
 }
 
 /// The cores this process may use.
@@ -170,162 +185,141 @@ fn cores() -> usize {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let mut interrupted = false;
     let result = match cli.command {
-        Cmd::Run {
-            deck: path,
-            steps,
-            output,
-            quiet,
-            threads,
-            procs,
-            walls,
-            restart,
-        } => deck::load(&path)
-            .map_err(|e| e.to_string())
-            .and_then(|scene| {
-                pdq::output::signals::install()?;
-                run::run(
-                    &scene,
-                    &run::RunOptions {
-                        steps,
-                        output,
-                        quiet,
-                        threads: threads.or(procs.as_ref().and_then(|p| match p {
-                            pdq::parallel::decomposition::Procs::Given(v) => {
-                                Some(v.iter().product())
-                            }
-                            pdq::parallel::decomposition::Procs::Auto => None,
-                        })),
-                        procs,
-                        walls,
-                        restart,
-                    },
-                )
-            })
-            .map(|s| {
-                if s.interrupted.is_some() {
-                    interrupted = true;
-                }
-            }),
-        Cmd::Validate {
-            output,
-            sweep: true,
-            models,
-            planes,
-            m,
-            solvers,
-            ..
-        } => pdq::lab::validate::sweep(&output, &models, &planes, &m, &solvers)
-            .map(|s| print!("{s}")),
-        Cmd::Validate {
-            output,
-            threads,
-            compare_adr: true,
-            ramp_periods,
-            ..
-        } => pdq::lab::validate::compare_adr(&output, threads.unwrap_or_else(cores), ramp_periods)
-            .map(|s| print!("{s}")),
-        Cmd::Validate {
-            quick: _,
-            full,
-            cases,
-            output,
-            threads,
-            compare_adr: false,
-            solver,
-            ..
-        } => pdq::lab::validate::run_all(&pdq::lab::validate::ValidateOptions {
-            implicit: solver.map_or(!full, |s| s == "implicit"),
-            level: if full {
-                pdq::lab::validate::Level::Full
-            } else {
-                pdq::lab::validate::Level::Quick
-            },
-            only: cases,
-            output,
-            threads: threads.unwrap_or_else(cores),
-        })
-        .and_then(|(table, ok)| {
-            print!("{table}");
-            if ok {
-                Ok(())
-            } else {
-                Err("an elastic case is outside its tolerance (see the table)".into())
-            }
+        Cmd::Run(a) => run_deck(a),
+        Cmd::Validate(a) => validate(a).map(|()| false),
+        Cmd::Stress(a) => stress(a).map(|()| false),
+        Cmd::Info { file } => pdq::output::checkpoint::info(&file).map(|s| {
+            print!("{s}");
+            false
         }),
-        Cmd::Stress {
-            quick,
-            sections,
-            models,
-            threads,
-            output,
-        } => pdq::lab::stress::run(&pdq::lab::stress::StressOptions {
-            quick,
-            sections,
-            models,
-            threads,
-        })
-        .and_then(|report| {
-            print!("{report}");
-            match output {
-                Some(path) => std::fs::write(&path, &report)
-                    .map_err(|e| format!("writing {}: {e}", path.display())),
-                None => Ok(()),
-            }
-        }),
-        Cmd::Info { file } => pdq::output::checkpoint::info(&file).map(|s| print!("{s}")),
         Cmd::Check { deck: path } => deck::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| run::check(&scene))
-            .map(|s| print!("{s}")),
+            .map(|s| {
+                print!("{s}");
+                false
+            }),
         Cmd::Models => {
             print!("{}", models_text());
-            Ok(())
+            Ok(false)
         }
-        Cmd::Bench {
-            model,
-            threads,
-            ranks,
-            walls,
-            procs,
-            no_yardstick,
-            steps,
-            n,
-            peer,
-            repeat,
-            rounds,
-            checkpoint,
-            savings,
-        } => bench::run(&bench::BenchOptions {
-            model,
-            threads,
-            ranks: if ranks.is_empty() && cfg!(feature = "mpi") && !launched_by_mpirun() {
-                vec![1, 2]
-            } else {
-                ranks
-            },
-            walls,
-            procs: procs.unwrap_or(pdq::parallel::decomposition::Procs::Auto),
-            yardstick: !no_yardstick,
-            steps,
-            n,
-            peer,
-            repeat,
-            rounds,
-            checkpoint,
-            savings,
-        })
-        .map(|s| print!("{s}")),
+        Cmd::Bench(a) => bench_command(a).map(|()| false),
     };
     match result {
-        Ok(()) if interrupted => ExitCode::from(pdq::output::signals::EXIT_INTERRUPTED),
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(true) => ExitCode::from(pdq::output::signals::EXIT_INTERRUPTED),
+        Ok(false) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
     }
+}
+
+/// `pdq run`; whether a signal interrupted the run (its checkpoint and outputs are written).
+fn run_deck(a: RunArgs) -> Result<bool, String> {
+    let scene = deck::load(&a.deck).map_err(|e| e.to_string())?;
+    pdq::output::signals::install()?;
+    // `--procs NXxNYxNZ` without `--threads` runs one thread per procCube.
+    let threads = a.threads.or(match &a.procs {
+        Some(pdq::parallel::decomposition::Procs::Given(v)) => Some(v.iter().product()),
+        _ => None,
+    });
+    let summary = run::run(
+        &scene,
+        &run::RunOptions {
+            steps: a.steps,
+            output: a.output,
+            quiet: a.quiet,
+            threads,
+            procs: a.procs,
+            walls: a.walls,
+            restart: a.restart,
+        },
+    )?;
+    Ok(summary.interrupted.is_some())
+}
+
+/// `pdq validate`: the cases, or the sweep, or ADR against an explicit ramp.
+fn validate(a: ValidateArgs) -> Result<(), String> {
+    let threads = a.threads.unwrap_or_else(cores);
+    if a.sweep {
+        let s = pdq::lab::validate::sweep(
+            &a.output,
+            &a.case_dir,
+            &a.models,
+            &a.planes,
+            &a.m,
+            &a.solvers,
+        )?;
+        print!("{s}");
+        return Ok(());
+    }
+    if a.compare_adr {
+        let s = pdq::lab::validate::compare_adr(&a.output, &a.case_dir, threads, a.ramp_periods)?;
+        print!("{s}");
+        return Ok(());
+    }
+    let (table, ok) = pdq::lab::validate::run_all(&pdq::lab::validate::ValidateOptions {
+        cases: a.case_dir,
+        implicit: a.solver.map_or(!a.full, |s| s == "implicit"),
+        level: if a.full {
+            pdq::lab::validate::Level::Full
+        } else {
+            pdq::lab::validate::Level::Quick
+        },
+        only: a.cases,
+        output: a.output,
+        threads,
+    })?;
+    print!("{table}");
+    if ok {
+        Ok(())
+    } else {
+        Err("an elastic case is outside its tolerance (see the table)".into())
+    }
+}
+
+/// `pdq stress`: the report, printed and written where asked.
+fn stress(a: StressArgs) -> Result<(), String> {
+    let report = pdq::lab::stress::run(&pdq::lab::stress::StressOptions {
+        quick: a.quick,
+        sections: a.sections,
+        models: a.models,
+        threads: a.threads,
+    })?;
+    print!("{report}");
+    match a.output {
+        Some(path) => {
+            std::fs::write(&path, &report).map_err(|e| format!("writing {}: {e}", path.display()))
+        }
+        None => Ok(()),
+    }
+}
+
+/// `pdq bench`.
+fn bench_command(a: BenchArgs) -> Result<(), String> {
+    let s = bench::run(&bench::BenchOptions {
+        model: a.model,
+        threads: a.threads,
+        ranks: if a.ranks.is_empty() && cfg!(feature = "mpi") && !launched_by_mpirun() {
+            vec![1, 2]
+        } else {
+            a.ranks
+        },
+        walls: a.walls,
+        procs: a.procs.unwrap_or(pdq::parallel::decomposition::Procs::Auto),
+        yardstick: !a.no_yardstick,
+        steps: a.steps,
+        n: a.n,
+        peer: a.peer,
+        repeat: a.repeat,
+        rounds: a.rounds,
+        checkpoint: a.checkpoint,
+        savings: a.savings,
+    })?;
+    print!("{s}");
+    Ok(())
 }
 
 /// Whether this process is an MPI rank started by mpirun (always false without the feature).

@@ -190,15 +190,6 @@ const STILL_LONG: &[(&str, &str, usize)] = &[
     ("src/input/deck.rs", "", 1698),
     ("src/input/deck.rs", "scene", 492),
     ("src/input/setup.rs", "build", 329),
-    ("src/lab/bench.rs", "", 779),
-    ("src/lab/bench.rs", "bench_setup", 135),
-    ("src/lab/stress.rs", "", 771),
-    ("src/lab/stress.rs", "run", 182),
-    ("src/lab/validate/girder.rs", "prestressed_girder", 176),
-    ("src/lab/validate.rs", "", 1452),
-    ("src/main.rs", "main", 159),
-    ("src/parallel/shuffle.rs", "shuffle", 252),
-    ("src/solve/implicit.rs", "assemble_tangent", 148),
 ];
 
 #[test]

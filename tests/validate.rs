@@ -11,6 +11,7 @@ fn out(name: &str) -> std::path::PathBuf {
 #[test]
 fn an_unknown_case_is_refused_with_the_list() {
     let e = validate::run_all(&ValidateOptions {
+        cases: "validation".into(),
         level: Level::Quick,
         implicit: false,
         only: vec!["cantilever_steel".into()],
@@ -70,7 +71,7 @@ history_every = 1
         &Case {
             name: "bar".into(),
             quantity: "tip displacement".into(),
-            unit: "m",
+            unit: "m".into(),
             kind: Kind::Elastic,
             reference: 1.0,
             thesis: None,
@@ -90,7 +91,7 @@ history_every = 1
     let case = Case {
         name: "bar".into(),
         quantity: "tip displacement".into(),
-        unit: "m",
+        unit: "m".into(),
         kind: Kind::Elastic,
         reference: 2.0 * measured,
         thesis: None,
@@ -144,6 +145,7 @@ fn the_sweep_reports_error_against_run_time() {
     let dir = out("sweep");
     let table = validate::sweep(
         &dir,
+        Path::new("validation"),
         &["pmb".to_string()],
         &[3, 5],
         &[3.0],
@@ -162,6 +164,7 @@ fn the_sweep_reports_error_against_run_time() {
     assert!(dir.join("sweep.png").exists() && dir.join("sweep.md").exists());
     let e = validate::sweep(
         &dir,
+        Path::new("validation"),
         &["pmb".to_string()],
         &[4],
         &[3.0],
@@ -172,14 +175,19 @@ fn the_sweep_reports_error_against_run_time() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
-/// Every case's deck, at both levels, is a valid deck (the long ones are not run in the test
-/// suite); the reinforced beams have their three bars and stop at their collapse, the
-/// lap splices their two bars, the prestressed girder its eight bars and three prestressed
-/// strands.
+/// Every case's deck, at both levels and by either solver, is a valid deck (the long ones are
+/// not run in the test suite); the reinforced beams have their three bars and stop at their
+/// collapse, the lap splices their two bars, the prestressed girder its eight bars and three
+/// prestressed strands.
 #[test]
 fn every_case_deck_parses() {
-    for level in [Level::Quick, Level::Full] {
-        for case in validate::cases(level) {
+    for (level, implicit) in [
+        (Level::Quick, false),
+        (Level::Quick, true),
+        (Level::Full, false),
+        (Level::Full, true),
+    ] {
+        for case in validate::cases(Path::new("validation"), level, implicit).unwrap() {
             let name = format!("{}.toml", case.name);
             if let Err(e) = pdq::input::deck::parse(&case.deck, &name, &case.name) {
                 panic!("{:?} {}: {e}", level, case.name);
@@ -221,7 +229,8 @@ fn every_case_deck_parses() {
 /// the run), and the damage picture is drawn.
 #[test]
 fn the_fast_lap_splice_pulls_out() {
-    let case = validate::cases(Level::Quick)
+    let case = validate::cases(Path::new("validation"), Level::Quick, false)
+        .unwrap()
         .into_iter()
         .find(|c| c.name == "lap_splice_fast")
         .expect("the case exists");

@@ -283,25 +283,20 @@ where
     let bonds_max_partner = bonds.max_partner();
     let (offsets, partner, geom, broken, history) = bonds.parts_mut();
     let n = x0.len();
-    assert!(
-        n_owned <= n
-            && offsets.len() == n_owned + 1
-            && state.len() >= n
-            && [
-                volume.len(),
-                material.len(),
-                fixed.len(),
-                alter.len(),
-                out.len()
-            ]
-            .iter()
-            .all(|&l| l == n)
-            && (bonds_max_partner < n || offsets.last() == Some(&0)),
-        "bond list does not match the particle store"
-    );
-    assert!(
-        M::BOND_LANES == 1 || <M::Bond as Attributes>::LEN == 0,
-        "a model with lanes keeps no bond history"
+    let lengths = [
+        volume.len(),
+        material.len(),
+        fixed.len(),
+        alter.len(),
+        out.len(),
+    ];
+    check_store::<M>(
+        n_owned,
+        n,
+        &lengths,
+        state.len(),
+        offsets,
+        bonds_max_partner,
     );
     let mut newly_broken = 0;
     for i in 0..n_owned {
@@ -345,15 +340,7 @@ where
             // broken bonds add nothing, so skipping them changes nothing. If one of the four
             // breaks, the model says so and they go one by one.
             if M::BOND_LANES == LANES {
-                let mut at = [0usize; LANES];
-                let (mut n, mut next) = (0, k);
-                while n < LANES && next < len {
-                    if !DAMAGE || !broken[next] {
-                        at[n] = next;
-                        n += 1;
-                    }
-                    next += 1;
-                }
+                let (at, n, next) = intact_group::<DAMAGE>(broken, k);
                 if n == LANES {
                     let js = at.map(|b| partner[b] as usize);
                     let sides = [side(js[0]), side(js[1]), side(js[2]), side(js[3])];
@@ -404,6 +391,46 @@ where
         add_assign(&mut out[i], &oi);
     }
     newly_broken
+}
+
+/// The bond list and the particle store must agree: this is what makes the unchecked partner
+/// access of [`sweep`] sound.
+fn check_store<M: Model>(
+    n_owned: usize,
+    n: usize,
+    lengths: &[usize],
+    states: usize,
+    offsets: &[u32],
+    max_partner: usize,
+) {
+    assert!(
+        n_owned <= n
+            && offsets.len() == n_owned + 1
+            && states >= n
+            && lengths.iter().all(|&l| l == n)
+            && (max_partner < n || offsets.last() == Some(&0)),
+        "bond list does not match the particle store"
+    );
+    assert!(
+        M::BOND_LANES == 1 || <M::Bond as Attributes>::LEN == 0,
+        "a model with lanes keeps no bond history"
+    );
+}
+
+/// The next `LANES` intact bonds of a particle's list from `k` on: their places, how many
+/// were found (fewer at the list's end) and where the search stopped.
+#[inline(always)]
+fn intact_group<const DAMAGE: bool>(broken: &[bool], k: usize) -> ([usize; LANES], usize, usize) {
+    let mut at = [0usize; LANES];
+    let (mut n, mut next) = (0, k);
+    while n < LANES && next < broken.len() {
+        if !DAMAGE || !broken[next] {
+            at[n] = next;
+            n += 1;
+        }
+        next += 1;
+    }
+    (at, n, next)
 }
 
 /// Adds a bond's contributions to its two ends, or marks it broken; returns how many broke.

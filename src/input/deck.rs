@@ -72,6 +72,9 @@ struct DeckFile {
     parallel: Option<Spanned<ParallelSection>>,
     #[serde(default)]
     solver: Option<Spanned<SolverSection>>,
+    /// What `pdq validate` reads (validation/README.md); a run ignores it.
+    #[serde(default, rename = "validation")]
+    _validation: Option<toml::Table>,
 }
 
 /// `[solver]`: explicit time stepping (the default) or quasi-static adaptive dynamic

@@ -4,16 +4,24 @@
 //! scene when asked, and a hand-specialized PMB force loop kept here only as a yardstick for
 //! what the generic model path costs.
 
-use crate::engine::forces;
 use crate::input::deck;
 use crate::input::setup;
 use crate::model::{Model, ModelVisitor};
-use crate::models::pmb::{Motion, Pmb};
 use crate::parallel;
 use crate::parallel::decomposition::{Procs, Walls};
 use std::fmt::Write as _;
-use std::process::Command;
-use std::time::Instant;
+
+mod peer;
+mod ranks;
+mod savings;
+mod yardstick;
+
+use peer::{peer, peer_style};
+use ranks::ranks_line;
+#[cfg(feature = "mpi")]
+use ranks::MpiVisit;
+use savings::savings;
+pub use yardstick::hand_pmb_pass;
 
 #[derive(Clone, Debug)]
 pub struct BenchOptions {
@@ -113,12 +121,6 @@ history_every = {steps}
         dt = if model == "micropolar" { 5e-8 } else { 1e-7 },
     ))
 }
-
-/// The LAMMPS input of the peer benchmark (`shared/bench/lammps_pmb.in`).
-/// The LAMMPS input of the LPS peer benchmark (`shared/bench/lammps_lps.in`).
-const LAMMPS_LPS: &str = "units si\nboundary s s s\natom_style peri\natom_modify map array\nlattice sc 0.001\nregion box block 0 ${n} 0 ${n} 0 ${n}\ncreate_box 1 box\ncreate_atoms 1 region box\npair_style peri/lps\npair_coeff * * 14.9e9 14.9e9 0.0030150 0.0005 0.25\nset group all density 2200\nset group all volume 1.0e-9\nvelocity all set 0.0 0.0 0.0 sum no units box\nregion top block INF INF INF INF $(v_n-2) ${n} units lattice\ngroup top region top\nvelocity top set 0.0 0.0 1.0 sum no units box\nneighbor 0.0010 bin\nfix 1 all nve\ntimestep 1.0e-7\nthermo 100\nrun ${steps}\n";
-
-const LAMMPS_PMB: &str = "units si\nboundary s s s\natom_style peri\natom_modify map array\nlattice sc 0.001\nregion box block 0 ${n} 0 ${n} 0 ${n}\ncreate_box 1 box\ncreate_atoms 1 region box\npair_style peri/pmb\npair_coeff * * 1.6863e22 0.0030150 0.0005 0.25\nset group all density 2200\nset group all volume 1.0e-9\nvelocity all set 0.0 0.0 0.0 sum no units box\nregion top block INF INF INF INF $(v_n-2) ${n} units lattice\ngroup top region top\nvelocity top set 0.0 0.0 1.0 sum no units box\nneighbor 0.0010 bin\nfix 1 all nve\ntimestep 1.0e-7\nthermo 100\nrun ${steps}\n";
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -305,35 +307,6 @@ fn suite_table(lines: &str) -> String {
     t
 }
 
-/// Under `mpirun`: this rank's procCube of the standard scene; rank 0 prints the line.
-#[cfg(feature = "mpi")]
-struct MpiVisit<'a>(&'a deck::Scene, &'a BenchOptions);
-#[cfg(feature = "mpi")]
-impl ModelVisitor for MpiVisit<'_> {
-    type Output = Result<String, String>;
-    fn visit<M: Model>(self, model: M) -> Self::Output {
-        use crate::parallel::comm::Transport;
-        let mpi = crate::parallel::comm_mpi::Mpi::init().ok_or("MPI was already initialized")?;
-        let (rank, ranks) = (mpi.rank(), mpi.size());
-        let setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
-        let layout = parallel::layout(&setup, &Procs::Auto, ranks, self.1.walls)?;
-        let plans = crate::parallel::decomposition::cell_plans(&layout);
-        let cube = parallel::build_cube(&setup, &layout, &plans, rank, Box::new(mpi));
-        let n = setup.sim.particles.len();
-        drop(setup);
-        let t = cube.timed_steps(self.1.steps);
-        Ok(if rank == 0 {
-            format!(
-                "{} launcher=mpirun layout={}\n",
-                line::<M>(n, self.1.steps, 1, ranks, &t),
-                layout.describe().replace(' ', "_")
-            )
-        } else {
-            String::new()
-        })
-    }
-}
-
 /// The time to gather and write a checkpoint of the scene (after 100 steps on one thread),
 /// against the time of those 100 steps.
 fn checkpoint_line<M: Model>(
@@ -365,56 +338,6 @@ fn checkpoint_line<M: Model>(
         cube.sim.bonds.len(),
         100.0 * seconds / step_seconds
     ))
-}
-
-/// `mpirun -np ranks`, allowed to run as root (containers) and on more ranks than cores.
-fn mpirun(ranks: usize) -> Command {
-    let mut c = Command::new("mpirun");
-    c.env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-        .args(["--oversubscribe", "-np"])
-        .arg(ranks.to_string());
-    c
-}
-
-/// Runs this program's bench under `mpirun -np ranks` and returns its line.
-fn ranks_line(opts: &BenchOptions, ranks: usize) -> Result<String, String> {
-    if !cfg!(feature = "mpi") {
-        return Ok(format!(
-            "bench ranks={ranks} skipped: this pdq was built without the 'mpi' feature (cargo build --release --features mpi)\n"
-        ));
-    }
-    let exe = std::env::current_exe().map_err(|e| e.to_string())?;
-    let out = mpirun(ranks)
-        .arg(exe)
-        .args([
-            "bench",
-            "--model",
-            &opts.model,
-            "--threads",
-            "1",
-            "--no-yardstick",
-            "--steps",
-        ])
-        .arg(opts.steps.to_string())
-        .arg("--n")
-        .arg(opts.n.to_string())
-        .args(["--walls", opts.walls.name()])
-        .output();
-    match out {
-        Ok(o) if o.status.success() => Ok(String::from_utf8_lossy(&o.stdout)
-            .lines()
-            .filter(|l| l.starts_with("bench"))
-            .map(|l| format!("{l}\n"))
-            .collect()),
-        Ok(o) => Err(format!(
-            "mpirun -np {ranks} failed: {}",
-            String::from_utf8_lossy(&o.stderr)
-        )),
-        Err(e) => Ok(format!(
-            "bench ranks={ranks} skipped: cannot run mpirun ({e}); install openmpi-bin\n"
-        )),
-    }
 }
 
 fn bench_setup<M: Model>(
@@ -488,292 +411,6 @@ fn bench_setup<M: Model>(
     if !opts.yardstick {
         return Ok((out, ours));
     }
-    let sim = &mut setup.sim;
-    for _ in 0..2 {
-        sim.advance();
-    }
-    // The yardstick: the generic pair pass against a hand-written PMB loop on the same state.
-    // Runs alternate (hand first on even repeats, generic first on odd ones) and the overhead
-    // is the median of the per-repeat ratios, so a slow spell of a shared machine hits both.
-    if let Some(pmb) = (&sim.model as &dyn std::any::Any).downcast_ref::<Pmb>() {
-        let law = pmb.laws()[0];
-        let (mut generic, mut hand, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
-        let mut identical = true;
-        let mut hand_force = vec![[0.0f64; 3]; sim.particles.len()];
-        let saved = sim.bonds.broken.clone();
-        for r in 0..opts.repeat.max(1) {
-            let mut hand_broken = saved.clone();
-            let time_hand = |sim: &crate::engine::simulation::Simulation<M>,
-                             broken: &mut [bool],
-                             force: &mut [[f64; 3]]| {
-                let alter: &[Motion] =
-                    bytemuck::cast_slice(bytemuck::cast_slice::<_, f64>(&sim.particles.alter));
-                let t = Instant::now();
-                hand_pmb_pass(
-                    alter,
-                    &sim.particles.volume,
-                    sim.bonds.offsets(),
-                    sim.bonds.partners(),
-                    &sim.bonds.geom,
-                    broken,
-                    force,
-                    law.c,
-                    law.s0,
-                );
-                t.elapsed().as_secs_f64()
-            };
-            let (th, tg) = if r % 2 == 0 {
-                let th = time_hand(sim, &mut hand_broken, &mut hand_force);
-                let t = Instant::now();
-                forces::pair_pass(&sim.model, &mut sim.particles, &mut sim.bonds);
-                (th, t.elapsed().as_secs_f64())
-            } else {
-                let t = Instant::now();
-                forces::pair_pass(&sim.model, &mut sim.particles, &mut sim.bonds);
-                let tg = t.elapsed().as_secs_f64();
-                (time_hand(sim, &mut hand_broken, &mut hand_force), tg)
-            };
-            hand.push(th);
-            generic.push(tg);
-            ratio.push(tg / th);
-            let g: &[f64] = bytemuck::cast_slice(&sim.particles.force);
-            identical &= g.chunks(3).zip(&hand_force).all(|(a, b)| a == &b[..]);
-            identical &= sim.bonds.broken == hand_broken;
-            sim.bonds.broken = saved.clone();
-        }
-        let _ = writeln!(
-            out,
-            "bench yardstick=hand-pmb particles={n} force_pass_ms_generic={:.3} force_pass_ms_hand={:.3} generic_overhead_percent={:+.1} identical_forces={identical} repeats={}",
-            1e3 * median(generic),
-            1e3 * median(hand),
-            100.0 * (median(ratio) - 1.0),
-            opts.repeat.max(1)
-        );
-    }
+    out.push_str(&yardstick::compare(&mut setup.sim, opts.repeat));
     Ok((out, ours))
-}
-
-/// The PMB force pass written by hand for this one model: the yardstick of the generic path.
-/// Not used by the engine.
-#[allow(clippy::too_many_arguments)]
-pub fn hand_pmb_pass(
-    alter: &[Motion],
-    volume: &[f64],
-    offsets: &[u32],
-    partner: &[u32],
-    geom: &[crate::model::BondGeom],
-    broken: &mut [bool],
-    force: &mut [[f64; 3]],
-    c: f64,
-    s0: f64,
-) {
-    force.fill([0.0; 3]);
-    for i in 0..offsets.len() - 1 {
-        let xi = alter[i].pos;
-        let vi = volume[i];
-        let mut fi = [0.0; 3];
-        for b in offsets[i] as usize..offsets[i + 1] as usize {
-            if broken[b] {
-                continue;
-            }
-            let j = partner[b] as usize;
-            let xj = alter[j].pos;
-            let y = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
-            let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
-            let l = geom[b].length;
-            let e = r - l;
-            if e > s0 * l {
-                broken[b] = true;
-                continue;
-            }
-            let f = c * geom[b].beta * vi * volume[j] * e / (l * r);
-            let fv = [f * y[0], f * y[1], f * y[2]];
-            fi[0] += fv[0];
-            fi[1] += fv[1];
-            fi[2] += fv[2];
-            force[j][0] -= fv[0];
-            force[j][1] -= fv[1];
-            force[j][2] -= fv[2];
-        }
-        force[i][0] += fi[0];
-        force[i][1] += fi[1];
-        force[i][2] += fi[2];
-    }
-}
-
-/// The LAMMPS pair style a model is compared with: `peri/lps` for LPS, `peri/pmb` for the rest.
-fn peer_style(model: &str) -> &'static str {
-    if model == "lps" {
-        "lps"
-    } else {
-        "pmb"
-    }
-}
-
-/// LAMMPS `peri/pmb` (or `peri/lps`) on the same scene: `Ok(Ok((line, µs per particle-step)))`, or
-/// `Ok(Err(line))` saying why it was skipped (no `lmp` on the PATH).
-#[allow(clippy::type_complexity)]
-fn peer(opts: &BenchOptions, ranks: usize) -> Result<Result<(String, f64), String>, String> {
-    let lmp = std::env::var("PDQ_LMP").unwrap_or_else(|_| "lmp".into());
-    let dir = std::env::temp_dir().join(format!("pdq-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let style = peer_style(&opts.model);
-    let (name, text) = if style == "lps" {
-        ("lammps_lps.in", LAMMPS_LPS)
-    } else {
-        ("lammps_pmb.in", LAMMPS_PMB)
-    };
-    let input = dir.join(name);
-    std::fs::write(&input, text).map_err(|e| e.to_string())?;
-    let mut cmd = if ranks > 1 {
-        let mut c = mpirun(ranks);
-        c.arg(&lmp);
-        c
-    } else {
-        Command::new(&lmp)
-    };
-    let output = cmd
-        .current_dir(&dir)
-        .args(["-in", name, "-var", "n"])
-        .arg(opts.n.to_string())
-        .args(["-var", "steps"])
-        .arg(opts.steps.to_string())
-        .args(["-log", "none"])
-        .output();
-    let _ = std::fs::remove_dir_all(&dir);
-    let output = match output {
-        Ok(o) => o,
-        Err(e) => {
-            return Ok(Err(format!(
-                "bench peer=lammps-peri/{style} skipped: cannot run '{lmp}' ({e}); install it with apt-get install lammps\n"
-            )))
-        }
-    };
-    let text = String::from_utf8_lossy(&output.stdout);
-    // "Loop time of 61.4 on 1 procs for 200 steps with 68921 atoms"
-    let line = text
-        .lines()
-        .find(|l| l.starts_with("Loop time of"))
-        .ok_or_else(|| format!("LAMMPS printed no 'Loop time' line:\n{text}"))?;
-    let w: Vec<&str> = line.split_whitespace().collect();
-    let secs: f64 = w
-        .get(3)
-        .and_then(|s| s.parse().ok())
-        .ok_or("bad Loop time line")?;
-    let atoms: f64 = w
-        .get(11)
-        .and_then(|s| s.parse().ok())
-        .ok_or("bad Loop time line")?;
-    let steps: f64 = w
-        .get(8)
-        .and_then(|s| s.parse().ok())
-        .ok_or("bad Loop time line")?;
-    let us = 1e6 * secs / (atoms * steps);
-    Ok(Ok((
-        format!(
-            "bench peer=lammps-peri/{style} particles={atoms} steps={steps} threads=1 ranks={ranks} us_per_particle_step={us:.4}\n"
-        ),
-        us,
-    )))
-}
-
-/// Steps of one deck on `threads` threads (layout auto, whole walls), with a shuffle check
-/// every `shuffle_every` steps: µs per particle-step and the share of the state pass.
-fn time_deck(
-    text: &str,
-    threads: usize,
-    steps: u64,
-    shuffle_every: u64,
-) -> Result<(f64, f64), String> {
-    let scene = deck::parse(text, "<bench>", "bench").map_err(|e| e.to_string())?;
-    struct Visit<'a>(&'a deck::Scene, usize, u64, u64);
-    impl ModelVisitor for Visit<'_> {
-        type Output = Result<(f64, f64), String>;
-        fn visit<M: Model>(self, model: M) -> Self::Output {
-            let Visit(scene, threads, steps, shuffle_every) = self;
-            let setup = setup::build(model, scene).map_err(|e| e.to_string())?;
-            let n = setup.sim.particles.n_owned;
-            let layout = parallel::layout(&setup, &Procs::Auto, threads, Walls::Whole)?;
-            let cubes = parallel::thread_cubes(&setup, &layout);
-            drop(setup);
-            let timed =
-                parallel::on_threads(cubes, |c| c.timed_steps_shuffling(steps, shuffle_every));
-            let t = timed.into_iter().next().ok_or("no procCube")??;
-            let state = t
-                .timing
-                .get(crate::engine::timing::Phase::State)
-                .as_secs_f64();
-            Ok((
-                1e6 * t.seconds / (n as f64 * steps as f64),
-                state / t.seconds,
-            ))
-        }
-    }
-    setup::with_model(&scene, Visit(&scene, threads, steps, shuffle_every))
-        .map_err(|e| e.to_string())?
-}
-
-/// `pdq bench --savings`: the standard scene with and without each feature a deck may leave
-/// out, alternating `rounds` times; medians and the saving.
-fn savings(opts: &BenchOptions) -> Result<String, String> {
-    let (n, steps) = (opts.n, opts.steps);
-    let pmb = standard_deck("pmb", n, steps)?;
-    let unbreakable = pmb.replace("critical_stretch = 0.0005\n", "");
-    let shuffling = format!("{pmb}[parallel]\nshuffle_every = 10\n");
-    // (feature, deck using it, threads, shuffle_every, deck without it, what differs)
-    let pairs: [(&str, String, usize, u64, String, &str); 4] = [
-        ("damage checks", pmb.clone(), 1, 0, unbreakable, "pmb with critical stretch 0.0005 against none (the engine drops the broken flags and break tests from the bond loop)"),
-        ("state pass", standard_deck("lps", n, steps)?, 1, 0, pmb.clone(), "lps against pmb, same scene: the state pass, its two exchanges and the state-based law"),
-        ("rotation DOFs", standard_deck("micropolar", n, steps)?, 1, 0, pmb.clone(), "micropolar (6 DOFs, moments) against pmb (3 DOFs), same stiffness; the difference includes the larger law"),
-        ("shuffling", shuffling, 2, 10, pmb, "pmb on 2 threads with shuffle_every = 10 (cells widened by the 0.25 skin) against small-motion mode"),
-    ];
-    let mut out = String::new();
-    let mut table = String::from("| feature | with it (µs per particle-step) | without (µs) | saving | runs | what is compared |\n|---|---|---|---|---|---|\n");
-    for (feature, used, threads, every, unused, what) in &pairs {
-        let (mut with, mut without, mut share) = (Vec::new(), Vec::new(), Vec::new());
-        for r in 0..opts.rounds.max(1) {
-            // Alternate which goes first, so a slow spell of the machine hits both.
-            let (a, b) = if r % 2 == 0 {
-                let a = time_deck(used, *threads, steps, *every)?;
-                (a, time_deck(unused, *threads, steps, 0)?)
-            } else {
-                let b = time_deck(unused, *threads, steps, 0)?;
-                (time_deck(used, *threads, steps, *every)?, b)
-            };
-            let _ = writeln!(
-                out,
-                "bench saving feature={} round={r} with_us={:.4} without_us={:.4}",
-                feature.replace(' ', "_"),
-                a.0,
-                b.0
-            );
-            with.push(a.0);
-            without.push(b.0);
-            share.push(a.1);
-        }
-        let (w, wo) = (median(with.clone()), median(without.clone()));
-        let saving = 100.0 * (w - wo) / w;
-        let _ = writeln!(
-            out,
-            "bench saving median feature={} with_us={w:.4} without_us={wo:.4} saving_percent={saving:.1} runs={}",
-            feature.replace(' ', "_"),
-            with.len()
-        );
-        let mut what = what.to_string();
-        if *feature == "state pass" {
-            let _ = write!(
-                what,
-                "; the state pass alone is {:.0} % of the lps step",
-                100.0 * median(share)
-            );
-        }
-        let _ = writeln!(
-            table,
-            "| {feature} | {w:.4} | {wo:.4} | {saving:.1} % | {} | {what} |",
-            with.len()
-        );
-    }
-    out.push('\n');
-    out.push_str(&table);
-    Ok(out)
 }

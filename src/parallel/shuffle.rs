@@ -63,10 +63,83 @@ impl<M: Model> Cube<M> {
         if !self.someone_left() {
             return Ok(false);
         }
-        let la = <M::Alter as Attributes>::LEN;
-        let lf = <M::Force as Attributes>::LEN;
-        let lx = <M::Fixed as Attributes>::LEN;
-        let lh = <M::Bond as Attributes>::LEN;
+        // Everyone gets everything: gather on the root, then the root's concatenation to all.
+        let mine = self.pack();
+        let mut team = self.team();
+        let mut all: Vec<u8> = team
+            .gather(bytemuck::cast_slice(&mine))
+            .map(|parts| parts.concat())
+            .unwrap_or_default();
+        team.broadcast(&mut all);
+        let mut whole = Whole::<M>::unpack(&f64s(&all), self.global_particles);
+
+        // Positions back into a periodic box, then the new layout from where particles are now.
+        let domain = self.layout.domain.clone();
+        let pos = whole.wrap(&domain);
+        let layout = Layout::new(self.layout.procs, &domain, &pos, self.layout.walls)?;
+        let plans = cell_plans(&layout);
+        let plan = cube_plan(&layout, &plans, self.plan.rank);
+
+        // This procCube's particles, owned then ghosts (images shifted).
+        let n = self.global_particles;
+        let g = |l: usize| plan.global[l] as usize;
+        let ids: Vec<u32> = (0..n as u32).collect();
+        let mut part = local_particles(
+            &self.sim.model,
+            &plan,
+            &ids,
+            &whole.x0,
+            &whole.volume,
+            &whole.material,
+            &whole.alter,
+        );
+        for l in 0..plan.n_owned {
+            part.force[l] = whole.force[g(l)];
+        }
+        for l in 0..plan.global.len() {
+            part.fixed[l] = whole.fixed[g(l)];
+        }
+        let mut local_of_owned = HashMap::with_capacity(plan.n_owned);
+        for l in 0..plan.n_owned {
+            local_of_owned.insert(plan.global[l] as u32, l as u32);
+        }
+        let list = whole.local_bonds(&pos, &layout, &plan, &local_of_owned)?;
+
+        // Dropped bonds live with the owner of their smaller id.
+        let mut dropped = std::mem::take(&mut whole.dropped);
+        dropped.sort_unstable();
+        self.dropped = dropped
+            .into_iter()
+            .filter(|(a, _)| local_of_owned.contains_key(a))
+            .collect();
+        self.lost = (0..plan.n_owned).map(|l| whole.lost[g(l)]).collect();
+
+        let mut local = vec![u32::MAX; n];
+        for l in 0..plan.n_owned {
+            local[g(l)] = l as u32;
+        }
+        let (mut constraints, loads, probes) = self.everywhere.share(&local);
+        // Reactions are reported before the next force evaluation: each procCube keeps its
+        // share (the sum over procCubes is what the history shows).
+        for (new, old) in constraints.iter_mut().zip(&self.sim.constraints) {
+            new.reaction.clone_from(&old.reaction);
+        }
+        self.sim.particles = part;
+        self.sim.bonds = list;
+        self.sim.constraints = constraints;
+        self.sim.loads = loads;
+        self.probes = probes;
+        self.wall.set_stages(plan.stages.clone());
+        self.plan = plan;
+        self.layout = layout;
+        // Ghosts are refreshed by the next step's exchange; forces came with their particles.
+        Ok(true)
+    }
+
+    /// This procCube's owned particles and bonds as f64 records: counts (particles, bonds,
+    /// dropped bonds), then a particle record each (`PARTICLE_HEAD` and the attributes), a bond
+    /// record each (`BOND_HEAD` and the history), and the dropped bonds' id pairs.
+    fn pack(&self) -> Vec<f64> {
         let p = &self.sim.particles;
         let b = &self.sim.bonds;
         let mut mine: Vec<f64> = vec![p.n_owned as f64, b.len() as f64, self.dropped.len() as f64];
@@ -94,27 +167,44 @@ impl<M: Model> Cube<M> {
         for &(a, c) in &self.dropped {
             mine.extend_from_slice(&[a as f64, c as f64]);
         }
-        // Everyone gets everything: gather on the root, then the root's concatenation to all.
-        let mut team = self.team();
-        let mut all: Vec<u8> = team
-            .gather(bytemuck::cast_slice(&mine))
-            .map(|parts| parts.concat())
-            .unwrap_or_default();
-        team.broadcast(&mut all);
-        let all = f64s(&all);
+        mine
+    }
+}
 
-        // The whole scene by global id.
-        let n = self.global_particles;
-        let mut x0 = vec![[0.0; 3]; n];
-        let mut volume = vec![0.0; n];
-        let mut material = vec![0u16; n];
-        let mut initial = vec![0u32; n];
-        let mut lost = vec![0u32; n];
-        let mut alter = vec![M::Alter::default(); n];
-        let mut force = vec![M::Force::default(); n];
-        let mut fixed = vec![M::Fixed::default(); n];
-        let mut bonds: Vec<(u32, u32, BondGeom, M::Bond)> = Vec::new();
-        let mut dropped: Vec<(u32, u32)> = Vec::new();
+/// The whole scene by global id, as every worker holds it during a shuffle.
+struct Whole<M: Model> {
+    x0: Vec<[f64; 3]>,
+    volume: Vec<f64>,
+    material: Vec<u16>,
+    initial: Vec<u32>,
+    lost: Vec<u32>,
+    alter: Vec<M::Alter>,
+    force: Vec<M::Force>,
+    fixed: Vec<M::Fixed>,
+    /// Intact bonds by global ids.
+    bonds: Vec<(u32, u32, BondGeom, M::Bond)>,
+    dropped: Vec<(u32, u32)>,
+}
+
+impl<M: Model> Whole<M> {
+    /// The scene from every worker's [`Cube::pack`] records, concatenated.
+    fn unpack(all: &[f64], n: usize) -> Self {
+        let la = <M::Alter as Attributes>::LEN;
+        let lf = <M::Force as Attributes>::LEN;
+        let lx = <M::Fixed as Attributes>::LEN;
+        let lh = <M::Bond as Attributes>::LEN;
+        let mut w = Whole::<M> {
+            x0: vec![[0.0; 3]; n],
+            volume: vec![0.0; n],
+            material: vec![0u16; n],
+            initial: vec![0u32; n],
+            lost: vec![0u32; n],
+            alter: vec![M::Alter::default(); n],
+            force: vec![M::Force::default(); n],
+            fixed: vec![M::Fixed::default(); n],
+            bonds: Vec::new(),
+            dropped: Vec::new(),
+        };
         let mut at = 0;
         while at < all.len() {
             let (np, nb, nd) = (all[at] as usize, all[at + 1] as usize, all[at + 2] as usize);
@@ -122,31 +212,27 @@ impl<M: Model> Cube<M> {
             for _ in 0..np {
                 let r = &all[at..at + PARTICLE_HEAD + la + lf + lx];
                 let g = r[0] as usize;
-                x0[g] = [r[1], r[2], r[3]];
-                volume[g] = r[4];
-                material[g] = r[5] as u16;
-                initial[g] = r[6] as u32;
+                w.x0[g] = [r[1], r[2], r[3]];
+                w.volume[g] = r[4];
+                w.material[g] = r[5] as u16;
+                w.initial[g] = r[6] as u32;
                 // Broken bonds from records read earlier may already have counted here.
-                lost[g] += r[7] as u32;
-                alter[g]
-                    .as_mut_slice()
-                    .copy_from_slice(&r[PARTICLE_HEAD..PARTICLE_HEAD + la]);
-                force[g]
-                    .as_mut_slice()
-                    .copy_from_slice(&r[PARTICLE_HEAD + la..PARTICLE_HEAD + la + lf]);
+                w.lost[g] += r[7] as u32;
+                let (alter, rest) = r[PARTICLE_HEAD..].split_at(la);
+                let (force, fixed) = rest.split_at(lf);
+                w.alter[g].as_mut_slice().copy_from_slice(alter);
+                w.force[g].as_mut_slice().copy_from_slice(force);
                 // Fixed data travels whole: bond sums (LPS weighted volume) are not redone.
-                fixed[g]
-                    .as_mut_slice()
-                    .copy_from_slice(&r[PARTICLE_HEAD + la + lf..]);
+                w.fixed[g].as_mut_slice().copy_from_slice(fixed);
                 at += PARTICLE_HEAD + la + lf + lx;
             }
             for _ in 0..nb {
                 let r = &all[at..at + BOND_HEAD + lh];
                 let (gi, gj) = (r[0] as u32, r[1] as u32);
                 if r[4] != 0.0 {
-                    dropped.push((gi.min(gj), gi.max(gj)));
-                    lost[gi as usize] += 1;
-                    lost[gj as usize] += 1;
+                    w.dropped.push((gi.min(gj), gi.max(gj)));
+                    w.lost[gi as usize] += 1;
+                    w.lost[gj as usize] += 1;
                 } else {
                     let mut h = M::Bond::default();
                     h.as_mut_slice().copy_from_slice(&r[BOND_HEAD..]);
@@ -154,57 +240,44 @@ impl<M: Model> Cube<M> {
                         length: r[2],
                         beta: r[3],
                     };
-                    bonds.push((gi, gj, geom, h));
+                    w.bonds.push((gi, gj, geom, h));
                 }
                 at += BOND_HEAD + lh;
             }
             for _ in 0..nd {
-                dropped.push((all[at] as u32, all[at + 1] as u32));
+                w.dropped.push((all[at] as u32, all[at + 1] as u32));
                 at += 2;
             }
         }
+        w
+    }
 
-        // Positions back into a periodic box (reference positions move with them, so
-        // displacements are unchanged), then the new layout from where particles are now.
-        let domain = self.layout.domain.clone();
-        let mut pos = vec![[0.0; 3]; n];
-        for g in 0..n {
-            let (w, shift) = wrap(pos_of::<M>(&alter[g]), &domain);
-            pos[g] = w;
-            let a = alter[g].as_mut_slice();
-            a[..3].copy_from_slice(&w);
-            for (x, s) in x0[g].iter_mut().zip(shift) {
+    /// Moves every position into the periodic box (reference positions move with them, so
+    /// displacements are unchanged) and returns the positions.
+    fn wrap(&mut self, domain: &crate::parallel::decomposition::Domain) -> Vec<[f64; 3]> {
+        let mut pos = vec![[0.0; 3]; self.alter.len()];
+        for ((p, alter), x0) in pos.iter_mut().zip(&mut self.alter).zip(&mut self.x0) {
+            let (w, shift) = wrap(pos_of::<M>(alter), domain);
+            *p = w;
+            alter.as_mut_slice()[..3].copy_from_slice(&w);
+            for (x, s) in x0.iter_mut().zip(shift) {
                 *x -= s;
             }
         }
-        let layout = Layout::new(self.layout.procs, &domain, &pos, self.layout.walls)?;
-        let plans = cell_plans(&layout);
-        let rank = self.plan.rank;
-        let plan = cube_plan(&layout, &plans, rank);
+        pos
+    }
 
-        // This procCube's particles, owned then ghosts (images shifted).
-        let m = plan.global.len();
-        let g = |l: usize| plan.global[l] as usize;
-        let ids: Vec<u32> = (0..n as u32).collect();
-        let mut part = local_particles(
-            &self.sim.model,
-            &plan,
-            &ids,
-            &x0,
-            &volume,
-            &material,
-            &alter,
-        );
-        for l in 0..plan.n_owned {
-            part.force[l] = force[g(l)];
-        }
-        for l in 0..m {
-            part.fixed[l] = fixed[g(l)];
-        }
-
-        // Bonds this procCube evaluates: from the cell of one end to the same cell or a
-        // half-shell neighbour holding the other.
-        let grid = &layout.domain.grid;
+    /// The bonds this procCube evaluates: from the cell of one end to the same cell or a
+    /// half-shell neighbour holding the other.
+    fn local_bonds(
+        &self,
+        pos: &[[f64; 3]],
+        layout: &Layout,
+        plan: &crate::parallel::decomposition::CubePlan,
+        local_of_owned: &HashMap<u32, u32>,
+    ) -> Result<BondList<M::Bond>, String> {
+        let domain = &layout.domain;
+        let grid = &domain.grid;
         let cell_at = |gid: u32| -> [i64; 3] {
             let c = grid.coords(&pos[gid as usize]);
             [c[0] as i64, c[1] as i64, c[2] as i64]
@@ -217,12 +290,8 @@ impl<M: Model> Cube<M> {
             .map(|(k, h)| (h.at, k))
             .collect();
         let (lo, hi) = (plan.cells.lo, plan.cells.hi);
-        let mut local_of_owned = HashMap::with_capacity(plan.n_owned);
-        for l in 0..plan.n_owned {
-            local_of_owned.insert(plan.global[l] as u32, l as u32);
-        }
         let mut mine: Vec<(u32, u32, BondGeom, M::Bond)> = Vec::new();
-        for &(a, b, geom, h) in &bonds {
+        for &(a, b, geom, h) in &self.bonds {
             let (ca, cb) = (cell_at(a), cell_at(b));
             let mut d = [0i64; 3];
             for k in 0..3 {
@@ -262,6 +331,15 @@ impl<M: Model> Cube<M> {
                 .unwrap_or_else(|_| panic!("shuffle: particle {j} is not in its cell"));
             mine.push((li, lj, geom, h));
         }
+        Ok(self.assemble(mine, plan))
+    }
+
+    /// A bond list from (local i, local j, geometry, history) records.
+    fn assemble(
+        &self,
+        mut mine: Vec<(u32, u32, BondGeom, M::Bond)>,
+        plan: &crate::parallel::decomposition::CubePlan,
+    ) -> BondList<M::Bond> {
         mine.sort_unstable_by_key(|&(i, j, _, _)| (i, j));
         let mut offsets = vec![0u32; plan.n_owned + 1];
         for &(i, ..) in &mine {
@@ -270,9 +348,9 @@ impl<M: Model> Cube<M> {
         for i in 0..plan.n_owned {
             offsets[i + 1] += offsets[i];
         }
-        let mut init_local = vec![0u32; m];
-        for l in 0..plan.n_owned {
-            init_local[l] = initial[g(l)];
+        let mut init_local = vec![0u32; plan.global.len()];
+        for (init, &g) in init_local.iter_mut().zip(&plan.global[..plan.n_owned]) {
+            *init = self.initial[g as usize];
         }
         let mut list: BondList<M::Bond> = BondList::assemble(
             offsets,
@@ -281,35 +359,7 @@ impl<M: Model> Cube<M> {
             init_local,
         );
         list.history = mine.iter().map(|b| b.3).collect();
-
-        // Dropped bonds live with the owner of their smaller id.
-        dropped.sort_unstable();
-        self.dropped = dropped
-            .into_iter()
-            .filter(|(a, _)| local_of_owned.contains_key(a))
-            .collect();
-        self.lost = (0..plan.n_owned).map(|l| lost[g(l)]).collect();
-
-        let mut local = vec![u32::MAX; n];
-        for l in 0..plan.n_owned {
-            local[g(l)] = l as u32;
-        }
-        let (mut constraints, loads, probes) = self.everywhere.share(&local);
-        // Reactions are reported before the next force evaluation: each procCube keeps its
-        // share (the sum over procCubes is what the history shows).
-        for (new, old) in constraints.iter_mut().zip(&self.sim.constraints) {
-            new.reaction.clone_from(&old.reaction);
-        }
-        self.sim.particles = part;
-        self.sim.bonds = list;
-        self.sim.constraints = constraints;
-        self.sim.loads = loads;
-        self.probes = probes;
-        self.wall.set_stages(plan.stages.clone());
-        self.plan = plan;
-        self.layout = layout;
-        // Ghosts are refreshed by the next step's exchange; forces came with their particles.
-        Ok(true)
+        list
     }
 }
 

@@ -366,36 +366,24 @@ impl<M: Model> Cube<M> {
             let broken = sim.bonds.broken_count();
             return factor(triplets, index, free, broken, 4 * n2 as u64, 0, start);
         }
-        // A state sums over a family: forces reach two bond lengths.
-        let reach = 2.0 * longest;
-        let colours = colour(&sim.particles.x0[..n], reach);
-        // Who can feel a particle: particles within `reach` (reference positions).
-        let x0 = sim.particles.x0[..n].to_vec();
-        let cell = reach * (1.0 + 1e-9);
-        let key = |p: &[f64; 3]| [0, 1, 2].map(|a| (p[a] / cell).floor() as i64);
-        let mut cells: std::collections::HashMap<[i64; 3], Vec<usize>> = Default::default();
-        for (i, p) in x0.iter().enumerate() {
-            cells.entry(key(p)).or_default().push(i);
-        }
-        let near = |i: usize, out: &mut Vec<usize>| {
-            out.clear();
-            let (p, c) = (x0[i], key(&x0[i]));
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        if let Some(list) = cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
-                            for &j in list {
-                                let r2 = (0..3).map(|a| (x0[j][a] - p[a]).powi(2)).sum::<f64>();
-                                if r2 <= cell * cell {
-                                    out.push(j);
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        };
+        self.state_tangent(index, free, shortest, 2.0 * longest, start)
+    }
 
+    /// The tangent of a state-based model by central differences of the force: particles of
+    /// one colour (farther apart than `reach`, which a force's dependence spans: a state sums
+    /// over a family, so two bond lengths) are nudged together, one DOF at a time.
+    fn state_tangent(
+        &mut self,
+        index: Vec<usize>,
+        free: usize,
+        shortest: f64,
+        reach: f64,
+        start: Instant,
+    ) -> Result<Tangent, String> {
+        let n2 = second_order::<M>();
+        let n = self.sim.particles.n_owned;
+        let colours = colour(&self.sim.particles.x0[..n], reach);
+        let neighbours = Neighbours::new(&self.sim.particles.x0[..n], reach);
         let saved_alter = self.sim.particles.alter.clone();
         let saved_broken = self.sim.bonds.broken.clone();
         let broken = saved_broken.iter().filter(|&&b| b).count();
@@ -440,7 +428,7 @@ impl<M: Model> Cube<M> {
                 }
                 for &i in &free_members {
                     let col = index[i * n2 + k];
-                    near(i, &mut rows);
+                    neighbours.within(i, &mut rows);
                     for &j in &rows {
                         for l in 0..n2 {
                             let row = index[j * n2 + l];
@@ -566,5 +554,53 @@ impl<M: Model> Cube<M> {
             converged: residual <= tolerance,
             diverged: false,
         })
+    }
+}
+
+/// Who can feel a particle: the particles within `reach` of it (reference positions), found
+/// through cells of that size.
+struct Neighbours {
+    x0: Vec<[f64; 3]>,
+    cell: f64,
+    cells: std::collections::HashMap<[i64; 3], Vec<usize>>,
+}
+
+impl Neighbours {
+    fn new(x0: &[[f64; 3]], reach: f64) -> Self {
+        let cell = reach * (1.0 + 1e-9);
+        let mut n = Neighbours {
+            x0: x0.to_vec(),
+            cell,
+            cells: Default::default(),
+        };
+        for (i, p) in x0.iter().enumerate() {
+            let k = n.key(p);
+            n.cells.entry(k).or_default().push(i);
+        }
+        n
+    }
+
+    fn key(&self, p: &[f64; 3]) -> [i64; 3] {
+        [0, 1, 2].map(|a| (p[a] / self.cell).floor() as i64)
+    }
+
+    /// The particles within reach of `i` (itself included) into `out`.
+    fn within(&self, i: usize, out: &mut Vec<usize>) {
+        out.clear();
+        let (p, c) = (self.x0[i], self.key(&self.x0[i]));
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    if let Some(list) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                        for &j in list {
+                            let r2 = (0..3).map(|a| (self.x0[j][a] - p[a]).powi(2)).sum::<f64>();
+                            if r2 <= self.cell * self.cell {
+                                out.push(j);
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 }

@@ -43,7 +43,28 @@
 //! the strands' transfer of prestress meet (validation/README.md), not the inclined crack
 //! through the web's centroid that V_cw describes.
 
-use super::{column, read_history, Case, Kind, Level, Plot, CONCRETE_E, FC};
+use super::formulas::Curve;
+use super::measures::{column, read_history};
+use super::{Case, Kind, Level, Plot};
+
+/// The thesis's concrete modulus, 3605 ksi (= 57,000√f'c psi), and f'c, in psi.
+const CONCRETE_E: f64 = 3.605e6;
+const FC: f64 = 4000.0;
+
+/// The thesis's concrete (docs/theory.md §8) as a deck's `[materials.concrete]` table.
+fn thesis_concrete() -> String {
+    format!(
+        r#"[materials.concrete]
+kind = "concrete"
+density = "145 lb/ft^3"
+youngs_modulus = "{CONCRETE_E} psi"
+poisson_ratio = 0.25
+tensile_stretch = 1.387e-4
+compressive_stretch = -1.1e-3
+compressive_strength = "{FC} psi"
+"#
+    )
+}
 
 /// The PCI BT-72 section as (y, z) vertices in inches: y across (0 to 42), z up from the soffit.
 const SECTION: [[f64; 2]; 14] = [
@@ -189,49 +210,38 @@ fn web_shear_cracking(span: f64, support: f64) -> (f64, f64, f64) {
 /// The girder at `level`: a 3 in lattice (`--quick`, about 11,700 particles) or a 2 in one
 /// (`--full`, about 37,000; the thesis's 1 in lattice, about 290,000 particles, would need a
 /// factored tangent far beyond this machine's memory).
-pub(super) fn prestressed_girder(level: Level) -> Case {
-    let dx = match level {
-        Level::Quick => 3.0,
-        Level::Full => 2.0,
-    };
-    // The support lines: the lattice plane nearest the bearing plates' middle, at each end.
-    let support = ((BEARING[0] / 2.0 / dx).floor() + 0.5) * dx;
-    let span = LENGTH - 2.0 * support;
-    let flexural = flexural_cracking_load(span, LOADING[0]);
-    let (v_cw, f_pc, web_shear) = web_shear_cracking(span, support);
-    let reference = flexural.min(web_shear);
-    let (area, yb, inertia) = transformed_section();
-    let polygon = SECTION
-        .iter()
-        .map(|[y, z]| format!("[\"{y} in\", \"{z} in\"]"))
-        .collect::<Vec<_>>()
-        .join(", ");
-    let steel = |name: &str, area: f64, at: &[[f64; 2]], prestress: Option<f64>| {
-        at.iter()
-            .map(|[y, z]| {
-                let pre = prestress.map_or(String::new(), |s| {
-                    format!(
-                        "prestress = \"{s} psi\"\ntransfer_length = \"{:.2} in\"\n",
-                        transfer_length()
-                    )
-                });
+/// The `[[bar]]`s of one kind of steel along the girder's length, prestressed if asked.
+fn steel(name: &str, area: f64, at: &[[f64; 2]], prestress: Option<f64>) -> String {
+    at.iter()
+        .map(|[y, z]| {
+            let pre = prestress.map_or(String::new(), |s| {
                 format!(
-                    "[[bar]]\nmaterial = \"{name}\"\narea = \"{area} in^2\"\nfrom = \"0 {y} {z} in\"\nto = \"{LENGTH} {y} {z} in\"\n{pre}"
+                    "prestress = \"{s} psi\"\ntransfer_length = \"{:.2} in\"\n",
+                    transfer_length()
                 )
-            })
-            .collect::<String>()
-    };
+            });
+            format!(
+                "[[bar]]\nmaterial = \"{name}\"\narea = \"{area} in^2\"\nfrom = \"0 {y} {z} in\"\nto = \"{LENGTH} {y} {z} in\"\n{pre}"
+            )
+        })
+        .collect::<String>()
+}
+
+/// The centre of the web across the section (in).
+const CENTRE: f64 = 21.0;
+
+/// The bearing plates under the ends and the loading plate on the top, as `[[geometry]]`.
+fn plates() -> String {
     let mid = LENGTH / 2.0;
-    let centre = 21.0;
     let plate = |x0: f64, x1: f64, y_width: f64, z0: f64| {
         format!(
             "[[geometry]]\nshape = \"box\"\nmaterial = \"steel\"\nmin = \"{x0} {} {z0} in\"\nmax = \"{x1} {} {} in\"\n",
-            centre - y_width / 2.0,
-            centre + y_width / 2.0,
+            CENTRE - y_width / 2.0,
+            CENTRE + y_width / 2.0,
             z0 + PLATE_THICKNESS
         )
     };
-    let plates = [
+    [
         plate(0.0, BEARING[0], BEARING[1], -PLATE_THICKNESS),
         plate(LENGTH - BEARING[0], LENGTH, BEARING[1], -PLATE_THICKNESS),
         plate(
@@ -241,7 +251,19 @@ pub(super) fn prestressed_girder(level: Level) -> Case {
             HEIGHT,
         ),
     ]
-    .concat();
+    .concat()
+}
+
+/// The girder's deck at spacing `dx` with its support lines at `support` from the ends and
+/// the load ramped in units of `reference`.
+fn girder_deck(dx: f64, support: f64, reference: f64) -> String {
+    let mid = LENGTH / 2.0;
+    let plates = plates();
+    let polygon = SECTION
+        .iter()
+        .map(|[y, z]| format!("[\"{y} in\", \"{z} in\"]"))
+        .collect::<Vec<_>>()
+        .join(", ");
     // Bonds crossing the bottom flange (π m⁴/4 per dx² of a plane at m = 3, as for the plain
     // beams' quarter section).
     let crack_bonds =
@@ -250,7 +272,7 @@ pub(super) fn prestressed_girder(level: Level) -> Case {
     let fine_steps = ((PEAK - FAST_TO) / FINE).round() as u32;
     let steps = FAST_STEPS + fine_steps;
     let (t_fast, t_end) = (FAST_STEPS as f64, steps as f64);
-    let deck = format!(
+    format!(
         r#"title = "validation: pretensioned BT-72 girder (thesis 4.6), {dx} in lattice"
 units = "in-lbf-s"
 [model]
@@ -310,7 +332,7 @@ progress = false
 history_every = 1
 frames_every = 100000000
 "#,
-        concrete = super::thesis_concrete(),
+        concrete = thesis_concrete(),
         strand_yield = STRAND_YIELD / STRAND_E,
         strands = steel("strand", STRAND_AREA, &STRANDS, Some(STRAND_STRESS)),
         bars = steel("steel", BAR_AREA, &BARS, None),
@@ -324,13 +346,29 @@ frames_every = 100000000
         l1 = mid + LOADING[0] / 2.0,
         top = HEIGHT + PLATE_THICKNESS,
         // Off the web's centre plane by half a spacing: on a particle, not between two.
-        y = centre - dx / 2.0,
-    );
+        y = CENTRE - dx / 2.0,
+    )
+}
+
+/// The girder case at `level`: its deck, the smaller ACI cracking load, and the measure.
+pub(super) fn prestressed_girder(level: Level) -> Case {
+    let dx = match level {
+        Level::Quick => 3.0,
+        Level::Full => 2.0,
+    };
+    // The support lines: the lattice plane nearest the bearing plates' middle, at each end.
+    let support = ((BEARING[0] / 2.0 / dx).floor() + 0.5) * dx;
+    let span = LENGTH - 2.0 * support;
+    let flexural = flexural_cracking_load(span, LOADING[0]);
+    let (v_cw, f_pc, web_shear) = web_shear_cracking(span, support);
+    let reference = flexural.min(web_shear);
+    let (area, yb, inertia) = transformed_section();
+    let deck = girder_deck(dx, support, reference);
     let elastic_mid = reference * span.powi(3) / (48.0 * CONCRETE_E * inertia);
     Case {
         name: "prestressed_girder".into(),
         quantity: "first cracking load (midspan; a crack has run)".into(),
-        unit: "lbf",
+        unit: "lbf".into(),
         kind: Kind::Strength,
         reference,
         thesis: None,
@@ -360,8 +398,8 @@ frames_every = 100000000
         plot: Some(Plot {
             x_label: "midspan deflection of the soffit (in)".into(),
             y_label: "midspan load (lbf)".into(),
-            reference: vec![(0.0, reference), (2.0 * elastic_mid, reference)],
-            measured: load_deflection,
+            reference: Curve::Points(vec![(0.0, reference), (2.0 * elastic_mid, reference)]),
+            measured: Box::new(load_deflection),
         }),
     }
 }

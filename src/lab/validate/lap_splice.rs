@@ -25,7 +25,9 @@
 //! so without this the cylinder turns about y under the two opposite pulls (a rigid rotation
 //! takes up the imposed motion at no force), which the real bars' bending stiffness prevents.
 
-use super::{column, read_history, Case, Kind, Level, Plot};
+use super::formulas::Curve;
+use super::measures::{column, read_history};
+use super::{Case, Kind, Level, Plot};
 
 /// Bar diameter and the cylinder's size (in).
 const BAR_DIAMETER: f64 = 1.0;
@@ -171,7 +173,7 @@ frames_every = 100000000
     Case {
         name: format!("lap_splice_{suffix}"),
         quantity: format!("peak pull force at {velocity} in/s"),
-        unit: "lbf",
+        unit: "lbf".into(),
         kind: Kind::Strength,
         reference,
         thesis: None,
@@ -188,8 +190,8 @@ frames_every = 100000000
         plot: Some(Plot {
             x_label: "separation of the two bars' gripped ends (in)".into(),
             y_label: "pull force (lbf)".into(),
-            reference: vec![(0.0, reference), (2.0 * END_TRAVEL, reference)],
-            measured: pull_against_separation,
+            reference: Curve::Points(vec![(0.0, reference), (2.0 * END_TRAVEL, reference)]),
+            measured: Box::new(pull_against_separation),
         }),
     }
 }
