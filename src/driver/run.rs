@@ -10,6 +10,8 @@ use crate::parallel;
 #[cfg(feature = "mpi")]
 use crate::parallel::comm::Transport;
 use crate::parallel::decomposition::{Layout, Procs, Walls};
+use crate::parallel::snapshot::Snapshot;
+use crate::solve::static_start::StaticStart;
 use std::path::PathBuf;
 
 pub use super::check::check;
@@ -123,7 +125,7 @@ fn solver_choice<M: Model>(
             ..
         } => {
             crate::solve::adr::check_model::<M>(implicit)
-                .map_err(|e| format!("{}:{}: {e}", scene.file, scene.solver_line))?;
+                .map_err(|e| format!("{}:{}: {e}", scene.file, scene.solver.line))?;
             if implicit {
                 SolverChoice::Implicit {
                     tolerance,
@@ -176,148 +178,228 @@ fn run_setup<M: Model>(
     // A static start is handed to the procCubes as a restart at step 0 is; a restart from a
     // checkpoint has passed it already.
     let static_start = match (&resume, scene.time.static_until) {
-        (None, Some(until)) => {
-            let walls = opts.walls.unwrap_or(scene.parallel.walls);
-            let at = |e: String| format!("{}:{}: {e}", scene.file, scene.time_line);
-            let s = crate::solve::static_start::solve(&setup, until, walls).map_err(at)?;
-            let stop = scene.time.stop_at_broken_bonds;
-            if stop > 0 && s.broken as u64 >= stop {
-                return Err(at(format!(
-                    "[time] the static start to static_until = {until:e} broke {} bonds, already as many as stop_at_broken_bonds = {stop}: the run would stop before it began; start earlier",
-                    s.broken
-                )));
-            }
-            s.state.restore_particles(&mut setup);
-            Some(s)
-        }
+        (None, Some(until)) => Some(static_start(&mut setup, scene, opts, until)?),
         _ => None,
     };
-    let restart_line = resume.as_ref().map(|c| {
-        format!(
+    if let (Some(c), false) = (&resume, opts.quiet) {
+        eprintln!(
             "restart    from step {} (t = {:.6e}) of {}: {} broken bonds",
             c.state.step,
             c.state.time,
             c.deck,
             c.state.broken.len()
-        )
-    });
-    let resume = resume
-        .as_ref()
-        .map(|c| &c.state)
-        .or(static_start.as_ref().map(|s| &s.state));
-    // Said after the run's header (`prepare`), by the root only.
-    let static_line = static_start.as_ref().map(|s| s.describe());
-    let say_static = |quiet: bool| {
-        if let (Some(line), false) = (&static_line, quiet) {
-            eprintln!("{line}");
-        }
-    };
-    if let (Some(line), false) = (&restart_line, opts.quiet) {
-        eprintln!("{line}");
+        );
     }
-    // The implicit solve assembles one matrix in one process.
-    let one_cube = |layout: &Layout| -> Result<(), String> {
+    let start = Prepared {
+        setup,
+        scene,
+        opts,
+        dir,
+        solver,
+        scene_hash,
+        resume,
+        static_start,
+    };
+    #[cfg(feature = "mpi")]
+    if crate::parallel::comm_mpi::launched_by_mpirun() {
+        return start.on_ranks();
+    }
+    start.on_threads()
+}
+
+/// The static start to `until`, restored into the scene; refused when it already breaks the
+/// bonds at which the run would stop.
+fn static_start<M: Model>(
+    setup: &mut Setup<M>,
+    scene: &Scene,
+    opts: &RunOptions,
+    until: f64,
+) -> Result<StaticStart, String> {
+    let walls = opts.walls.unwrap_or(scene.parallel.walls);
+    let at = |e: String| format!("{}:{}: {e}", scene.file, scene.time.line);
+    let s = crate::solve::static_start::solve(setup, until, walls).map_err(at)?;
+    let stop = scene.time.stop_at_broken_bonds;
+    if stop > 0 && s.broken as u64 >= stop {
+        return Err(at(format!(
+            "[time] the static start to static_until = {until:e} broke {} bonds, already as many as stop_at_broken_bonds = {stop}: the run would stop before it began; start earlier",
+            s.broken
+        )));
+    }
+    s.state.restore_particles(setup);
+    Ok(s)
+}
+
+/// A run ready to be laid out: the scene built, the solver chosen, the state to start from.
+struct Prepared<'a, M: Model> {
+    setup: Setup<M>,
+    scene: &'a Scene,
+    opts: &'a RunOptions,
+    dir: PathBuf,
+    solver: SolverChoice,
+    scene_hash: u64,
+    resume: Option<Checkpoint>,
+    static_start: Option<StaticStart>,
+}
+
+impl<M: Model> Prepared<'_, M> {
+    /// The implicit solve assembles one matrix in one process.
+    fn one_cube(&self, layout: &Layout) -> Result<(), String> {
         let cubes: usize = layout.procs.iter().product();
-        if matches!(solver, SolverChoice::Implicit { .. }) && cubes > 1 {
+        if matches!(self.solver, SolverChoice::Implicit { .. }) && cubes > 1 {
             return Err(format!(
                 "{}:{}: [solver] kind = \"implicit\" runs on one procCube, the layout has {cubes} (--threads 1, no mpirun); use kind = \"adr\" for several",
-                scene.file, scene.solver_line
+                self.scene.file, self.scene.solver.line
             ));
         }
         Ok(())
-    };
-    let plan = |layout: &Layout| Plan {
-        columns: columns(&setup),
-        dir: dir.clone(),
-        steps: setup.steps,
-        every: scene.output.history_every,
-        frames_every: scene.output.frames_every,
-        progress: scene.output.progress,
-        quiet: opts.quiet,
-        final_state: scene.output.final_state,
-        shuffle_every: scene.parallel.shuffle_every,
-        stop_at_broken: scene.time.stop_at_broken_bonds,
-        probe_stops: scene
-            .probes
-            .iter()
-            .map(|p| (p.name.clone(), p.stop_beyond))
-            .collect(),
-        layout: layout.describe(),
-        first_step: resume.map_or(0, |c| c.step),
-        static_evaluations: static_start.as_ref().map_or(0, |s| s.evaluations),
-        solver: solver.clone(),
-        dt_critical: setup.dt_limit(),
-        dt_critical_name: if setup.dt_measured.is_some() {
-            "measured critical step"
-        } else {
-            "stable bound"
-        },
-        material_names: scene.materials.iter().map(|m| m.name.clone()).collect(),
-        spacing: scene.spacing,
-        checkpoints: CheckpointPlan {
-            dir: dir.join("checkpoints"),
-            every: scene.output.checkpoint_every,
-            minutes: scene.output.checkpoint_minutes,
-            keep: scene.output.checkpoint_keep,
-            scene_hash,
-            deck: scene.file.clone(),
-        },
-    };
+    }
 
+    /// Said after the run's header (`prepare`), by the root only.
+    fn say_static(&self, quiet: bool) {
+        if let (Some(s), false) = (&self.static_start, quiet) {
+            eprintln!("{}", s.describe());
+        }
+    }
+
+    /// The state the procCubes start from: a checkpoint's, or the static start's.
+    fn start_state(&self) -> Option<&Snapshot> {
+        let resume = self.resume.as_ref().map(|c| &c.state);
+        resume.or(self.static_start.as_ref().map(|s| &s.state))
+    }
+
+    /// What the step loop needs to know about the run on `layout`.
+    fn plan(&self, layout: &Layout) -> Plan {
+        let (setup, scene, out) = (&self.setup, self.scene, &self.scene.output);
+        Plan {
+            columns: columns(setup),
+            dir: self.dir.clone(),
+            steps: setup.steps,
+            every: out.history_every,
+            frames_every: out.frames_every,
+            progress: out.progress,
+            quiet: self.opts.quiet,
+            final_state: out.final_state,
+            shuffle_every: scene.parallel.shuffle_every,
+            stop_at_broken: scene.time.stop_at_broken_bonds,
+            probe_stops: scene
+                .probes
+                .iter()
+                .map(|p| (p.name.clone(), p.stop_beyond))
+                .collect(),
+            layout: layout.describe(),
+            first_step: self.start_state().map_or(0, |c| c.step),
+            static_evaluations: self.static_start.as_ref().map_or(0, |s| s.evaluations),
+            solver: self.solver.clone(),
+            dt_critical: setup.dt_limit(),
+            dt_critical_name: if setup.dt_measured.is_some() {
+                "measured critical step"
+            } else {
+                "stable bound"
+            },
+            material_names: scene.materials.iter().map(|m| m.name.clone()).collect(),
+            spacing: scene.spacing,
+            checkpoints: CheckpointPlan {
+                dir: self.dir.join("checkpoints"),
+                every: out.checkpoint_every,
+                minutes: out.checkpoint_minutes,
+                keep: out.checkpoint_keep,
+                scene_hash: self.scene_hash,
+                deck: scene.file.clone(),
+            },
+        }
+    }
+
+    /// One procCube per rank under `mpirun`; the root gathers the frames and the summary.
     #[cfg(feature = "mpi")]
-    if crate::parallel::comm_mpi::launched_by_mpirun() {
+    fn on_ranks(self) -> Result<Summary, String> {
+        let (scene, opts) = (self.scene, self.opts);
         let mpi = crate::parallel::comm_mpi::Mpi::init().ok_or("MPI was already initialized")?;
         let (rank, ranks) = (mpi.rank(), mpi.size());
-        let layout = choose_layout(&setup, scene, opts, ranks)?;
-        one_cube(&layout)?;
+        let layout = choose_layout(&self.setup, scene, opts, ranks)?;
+        self.one_cube(&layout)?;
         // Every rank makes the directory (the same one, on a shared file system), so that a
         // failure stops them all instead of leaving some waiting for the root.
         let quiet = RunOptions {
             quiet: opts.quiet || rank != 0,
             ..opts.clone()
         };
-        prepare(&setup, scene, &quiet, &dir, &layout, "ranks", ranks)?;
-        say_static(quiet.quiet);
+        prepare(
+            &self.setup,
+            scene,
+            &quiet,
+            &self.dir,
+            &layout,
+            "ranks",
+            ranks,
+        )?;
+        self.say_static(quiet.quiet);
         let plans = crate::parallel::decomposition::cell_plans(&layout);
-        let cube = parallel::build_cube(&setup, &layout, &plans, rank, Box::new(mpi));
-        let p = plan(&layout);
+        let cube = parallel::build_cube(&self.setup, &layout, &plans, rank, Box::new(mpi));
+        let p = self.plan(&layout);
+        let Prepared {
+            setup,
+            resume,
+            static_start,
+            ..
+        } = self;
+        let start = resume.as_ref().map(|c| &c.state);
+        let start = start.or(static_start.as_ref().map(|s| &s.state));
         let store = (rank == 0).then(|| frame_store(setup));
-        let summary = drive(cube, &p, store, resume)?;
-        return match summary {
+        match drive(cube, &p, store, start)? {
             Some(s) => {
                 report(&s, opts, scene.output.frames_every > 0);
                 Ok(s)
             }
             // Other ranks have nothing to print; a summary-less Ok ends them quietly.
             None => std::process::exit(0),
-        };
-    }
-
-    let threads = opts.threads.unwrap_or(scene.parallel.threads);
-    let layout = choose_layout(&setup, scene, opts, threads)?;
-    one_cube(&layout)?;
-    prepare(&setup, scene, opts, &dir, &layout, "threads", threads)?;
-    say_static(opts.quiet);
-    let cubes = parallel::thread_cubes(&setup, &layout);
-    let p = plan(&layout);
-    let store = std::sync::Mutex::new(Some(frame_store(setup)));
-    let results = parallel::on_threads(cubes, |cube| {
-        let s = if cube.plan.rank == 0 {
-            store.lock().unwrap().take()
-        } else {
-            None
-        };
-        drive(cube, &p, s, resume)
-    });
-    let mut summary = None;
-    for r in results {
-        if let Some(s) = r? {
-            summary = Some(s);
         }
     }
-    let summary = summary.ok_or("the root procCube returned no summary")?;
-    report(&summary, opts, scene.output.frames_every > 0);
-    Ok(summary)
+
+    /// One procCube per worker thread; the root's thread gathers the frames and the summary.
+    fn on_threads(self) -> Result<Summary, String> {
+        let (scene, opts) = (self.scene, self.opts);
+        let threads = opts.threads.unwrap_or(scene.parallel.threads);
+        let layout = choose_layout(&self.setup, scene, opts, threads)?;
+        self.one_cube(&layout)?;
+        prepare(
+            &self.setup,
+            scene,
+            opts,
+            &self.dir,
+            &layout,
+            "threads",
+            threads,
+        )?;
+        self.say_static(opts.quiet);
+        let cubes = parallel::thread_cubes(&self.setup, &layout);
+        let p = self.plan(&layout);
+        let Prepared {
+            setup,
+            resume,
+            static_start,
+            ..
+        } = self;
+        let start = resume.as_ref().map(|c| &c.state);
+        let start = start.or(static_start.as_ref().map(|s| &s.state));
+        let store = std::sync::Mutex::new(Some(frame_store(setup)));
+        let results = parallel::on_threads(cubes, |cube| {
+            let s = if cube.plan.rank == 0 {
+                store.lock().unwrap().take()
+            } else {
+                None
+            };
+            drive(cube, &p, s, start)
+        });
+        let mut summary = None;
+        for r in results {
+            if let Some(s) = r? {
+                summary = Some(s);
+            }
+        }
+        let summary = summary.ok_or("the root procCube returned no summary")?;
+        report(&summary, opts, scene.output.frames_every > 0);
+        Ok(summary)
+    }
 }
 
 /// Reads the checkpoint to resume from, checks that it belongs to this deck, and puts its

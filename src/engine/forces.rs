@@ -282,7 +282,6 @@ where
     }
     let bonds_max_partner = bonds.max_partner();
     let (offsets, partner, geom, broken, history) = bonds.parts_mut();
-    let n = x0.len();
     let lengths = [
         volume.len(),
         material.len(),
@@ -290,14 +289,8 @@ where
         alter.len(),
         out.len(),
     ];
-    check_store::<M>(
-        n_owned,
-        n,
-        &lengths,
-        state.len(),
-        offsets,
-        bonds_max_partner,
-    );
+    let (n, n_state) = (x0.len(), state.len());
+    check_store::<M>(n_owned, n, &lengths, n_state, offsets, bonds_max_partner);
     let mut newly_broken = 0;
     for i in 0..n_owned {
         // Local copies: the compiler cannot tell that the stores into `out` below leave
@@ -343,19 +336,13 @@ where
                 let (at, n, next) = intact_group::<DAMAGE>(broken, k);
                 if n == LANES {
                     let js = at.map(|b| partner[b] as usize);
-                    let sides = [side(js[0]), side(js[1]), side(js[2]), side(js[3])];
-                    let laws = [
-                        law_of(side_i.material, sides[0].material),
-                        law_of(side_i.material, sides[1].material),
-                        law_of(side_i.material, sides[2].material),
-                        law_of(side_i.material, sides[3].material),
-                    ];
-                    if let Some(f) = visit.visit_lanes(
-                        [&laws[0], &laws[1], &laws[2], &laws[3]],
-                        &side_i,
-                        [&sides[0], &sides[1], &sides[2], &sides[3]],
-                        [&geom[at[0]], &geom[at[1]], &geom[at[2]], &geom[at[3]]],
-                    ) {
+                    let sides = js.map(side);
+                    let laws = sides
+                        .each_ref()
+                        .map(|s| law_of(side_i.material, s.material));
+                    let geoms = at.map(|b| &geom[b]);
+                    let lanes = (laws.each_ref(), sides.each_ref());
+                    if let Some(f) = visit.visit_lanes(lanes.0, &side_i, lanes.1, geoms) {
                         // SAFETY: partners are in bounds, as above.
                         unsafe { add_lanes(&mut oi, out, js, &f) };
                         k = next;

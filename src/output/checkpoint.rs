@@ -67,7 +67,7 @@ pub fn scene_hash<M: Model>(setup: &Setup<M>, scene: &crate::input::deck::Scene)
     h.bytes(format!("{:?}{:?}", scene.materials, scene.model_options).as_bytes());
     // Bars: which particle belongs to which (their own bonds are calibrated) and their
     // prestrain, which a restart must not change under bonds that already carry it.
-    h.bytes(format!("{:?}{:?}", setup.bars.bar_of, scene.bar_prestrain).as_bytes());
+    h.bytes(format!("{:?}{:?}", setup.bars.bar_of, scene.bar_prestrain()).as_bytes());
     h.f64s(&[setup.horizon, setup.spacing]);
     h.bytes(&(p.len() as u64).to_le_bytes());
     for i in order {

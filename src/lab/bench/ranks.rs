@@ -13,7 +13,7 @@ use std::process::Command;
 
 /// Under `mpirun`: this rank's procCube of the standard scene; rank 0 prints the line.
 #[cfg(feature = "mpi")]
-pub(super) struct MpiVisit<'a>(&'a deck::Scene, &'a BenchOptions);
+pub(super) struct MpiVisit<'a>(pub &'a deck::Scene, pub &'a BenchOptions);
 #[cfg(feature = "mpi")]
 impl ModelVisitor for MpiVisit<'_> {
     type Output = Result<String, String>;

@@ -120,7 +120,7 @@ impl<'a> Beam<'a> {
         let (min, max, material) = scene
             .ops
             .iter()
-            .find_map(|op| match op {
+            .find_map(|op| match &op.item {
                 Op::Add {
                     shape: Shape::Box { min, max },
                     material,
@@ -271,12 +271,12 @@ fn aci_shear(scene: &Scene, beam: &Beam) -> Result<(f64, String), String> {
     let z = scene
         .bars
         .iter()
-        .map(|b| 0.5 * (b.from[2] + b.to[2]))
+        .map(|b| 0.5 * (b.bar.from[2] + b.bar.to[2]))
         .sum::<f64>()
         / n;
     let top = z > beam.depth / 2.0;
     let d = if top { z } else { beam.depth - z };
-    let area: f64 = scene.bars.iter().map(|b| b.area).sum();
+    let area: f64 = scene.bars.iter().map(|b| b.bar.area).sum();
     let words = format!(
         "f'c = {fc:.0} psi, b = {} in, d = {d} in; {} bars of {:.2} in² (ρ = {:.3}) at the {}",
         beam.width,

@@ -1,0 +1,86 @@
+//! `[output]` and `[[probe]]`: where the run writes, how often, its checkpoints, and the
+//! points whose displacement is recorded (and may end the run).
+
+use super::convert::{valid_name, Converter, R};
+use super::sections::{OutputSection, ProbeSection};
+use super::spec::{OutputSpec, ProbeSpec};
+use std::path::PathBuf;
+use toml::Spanned;
+
+impl Converter {
+    /// `[output]`, its defaults when the deck leaves it out; `stem` names the default directory.
+    pub(super) fn output(
+        &self,
+        section: Option<&Spanned<OutputSection>>,
+        stem: &str,
+    ) -> R<OutputSpec> {
+        let (out, line) = match section {
+            Some(o) => (o.get_ref(), self.line_of(o)),
+            None => (&OutputSection::default(), 1),
+        };
+        let history_every = out.history_every.unwrap_or(10);
+        if history_every == 0 {
+            return self.err(line, "[output] history_every must be ≥ 1");
+        }
+        let output = OutputSpec {
+            directory: PathBuf::from(
+                out.directory
+                    .clone()
+                    .unwrap_or_else(|| format!("out/{stem}")),
+            ),
+            history_every,
+            frames_every: out.frames_every.unwrap_or(0),
+            progress: out.progress.unwrap_or(true),
+            final_state: out.final_state.unwrap_or(false),
+            checkpoint_every: out.checkpoint_every.unwrap_or(0),
+            checkpoint_minutes: out.checkpoint_minutes.unwrap_or(0.0),
+            checkpoint_keep: out.checkpoint_keep.unwrap_or(3),
+            restart: out.restart.as_ref().map(PathBuf::from),
+        };
+        if !(output.checkpoint_minutes.is_finite() && output.checkpoint_minutes >= 0.0) {
+            return self.err(line, "[output] checkpoint_minutes must be ≥ 0");
+        }
+        if output.checkpoint_keep == 0 {
+            return self.err(line, "[output] checkpoint_keep must be ≥ 1");
+        }
+        Ok(output)
+    }
+
+    /// The probes in deck order; names are unique (each is a history column).
+    pub(super) fn probes(&self, entries: &[Spanned<ProbeSection>]) -> R<Vec<ProbeSpec>> {
+        let mut probes: Vec<ProbeSpec> = Vec::new();
+        for p in entries {
+            let line = self.line_of(p);
+            let name = p.get_ref().name.clone();
+            if !valid_name(&name) {
+                return self.err(
+                    line,
+                    format!("probe name '{name}' must be letters, digits, '_' or '-'"),
+                );
+            }
+            if probes.iter().any(|p| p.name == name) {
+                return self.err(line, format!("probe name '{name}' is used twice"));
+            }
+            let stop_beyond = match &p.get_ref().stop_beyond {
+                None => f64::INFINITY,
+                Some(d) => {
+                    let d = d.value(self.sys);
+                    if !(d.is_finite() && d > 0.0) {
+                        return self.err(
+                            line,
+                            format!("probe '{name}': stop_beyond must be a length > 0 (got {d})"),
+                        );
+                    }
+                    d
+                }
+            };
+            probes.push(ProbeSpec {
+                name,
+                line,
+                at: self.finite3(p.get_ref().at.value(self.sys), line, "probe: 'at'")?,
+                stop_beyond,
+            });
+        }
+        Ok(probes)
+    }
+}

@@ -1,0 +1,280 @@
+//! What the engine gets from a deck: the checked types, everything converted to the deck's
+//! unit system. Each deck entry that a later message may have to point at carries its line:
+//! a `line` field in the types of this module, [`Located`] around the engine's own types.
+
+use super::DeckError;
+use crate::engine::boundary::{History, Motion};
+use crate::engine::simulation::Integrator;
+use crate::input::bars::Prestrain;
+use crate::input::geometry::{Bar, Lattice, Op, Shape};
+use crate::input::materials::MaterialLines;
+use crate::input::procs::{Procs, Walls};
+use crate::input::units::UnitSystem;
+use crate::model::{Material, ModelError, OptionValue};
+use std::path::PathBuf;
+
+/// A checked deck entry and the line it was written at, for messages that point back at it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Located<T> {
+    pub item: T,
+    /// Deck line; 0 for a section the deck leaves out (its defaults apply).
+    pub line: usize,
+}
+
+/// A set of particles, selected in the reference configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Region {
+    All,
+    Shape(Shape),
+    Ids(Vec<u32>),
+}
+
+/// How long to run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RunLength {
+    Steps(u64),
+    Duration(f64),
+}
+
+/// How the run is cut into procCubes and run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParallelSpec {
+    pub line: usize,
+    pub procs: Procs,
+    /// Worker threads (one procCube each) when not under MPI.
+    pub threads: usize,
+    pub walls: Walls,
+    /// Steps between particle shuffles (0: never).
+    pub shuffle_every: u64,
+    /// Cells are the horizon times 1 + skin, so that stretched bonds stay between neighbours.
+    pub skin: f64,
+}
+
+/// How the critical time step of an explicit run is found (`[time] critical_step`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CriticalStep {
+    /// The Silling–Askari bound, per particle from its bonds (docs/theory.md §4).
+    Bound,
+    /// 2/√λ_max(M⁻¹K), the limit of central differences, with λ_max measured by a Lanczos run
+    /// at setup (`spectrum::critical_time_step`).
+    Measured,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeSpec {
+    /// Deck line of `[time]`, for messages.
+    pub line: usize,
+    pub length: RunLength,
+    pub dt: Option<f64>,
+    pub safety_factor: f64,
+    /// What Δt_crit is: the Silling–Askari bound, or measured from the stiffest mode.
+    pub critical_step: CriticalStep,
+    /// Reach this time by one static (implicit) solve, then step explicitly from rest there
+    /// (`[time] static_until`); `None`: step from time 0.
+    pub static_until: Option<f64>,
+    pub force_dt: bool,
+    pub integrator: Integrator,
+    /// End the run after the first step (load step) at which at least this many bonds have
+    /// broken; 0 = run to the end.
+    pub stop_at_broken_bonds: u64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoundarySpec {
+    pub name: String,
+    pub line: usize,
+    pub region: Region,
+    pub dofs: Vec<usize>,
+    pub motion: Motion,
+    pub history: History,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LoadKind {
+    /// The vector on every particle of the region.
+    PerParticle([f64; 3]),
+    /// The vector shared among the region's particles in proportion to their volumes.
+    Total([f64; 3]),
+    /// Force per unit volume.
+    BodyForce([f64; 3]),
+    /// Acceleration, applied as mass × g.
+    Gravity([f64; 3]),
+    /// Heat per unit time and area, on a region one lattice layer thick (V_i / spacing each).
+    HeatFlux(f64),
+    /// Heat per unit time and volume.
+    HeatSource(f64),
+    /// Heat per unit time, shared by volume.
+    TotalHeat(f64),
+}
+
+impl LoadKind {
+    /// Whether the load heats (first-order temperature DOF) rather than pushes.
+    pub fn is_heat(&self) -> bool {
+        matches!(
+            self,
+            LoadKind::HeatFlux(_) | LoadKind::HeatSource(_) | LoadKind::TotalHeat(_)
+        )
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadSpec {
+    pub name: String,
+    pub line: usize,
+    pub region: Region,
+    pub kind: LoadKind,
+    pub history: History,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct InitialSpec {
+    pub line: usize,
+    pub region: Region,
+    pub velocity: Option<[f64; 3]>,
+    pub angular_velocity: Option<[f64; 3]>,
+    pub temperature: Option<f64>,
+}
+
+/// How the deck's loads are followed in time.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SolverSpec {
+    /// Explicit time integration (`[time]` integrator).
+    Explicit,
+    /// Adaptive dynamic relaxation to equilibrium at each of `load_steps` equal steps of the
+    /// loads' time history (docs/theory.md §5).
+    Relaxation {
+        load_steps: u64,
+        /// Converged when |residual force| ≤ tolerance × |applied force and reactions|.
+        tolerance: f64,
+        /// Force evaluations per load step (ADR), Newton iterations per load step (implicit).
+        max_iterations: u64,
+        /// Newton's method with the assembled tangent (`kind = "implicit"`) instead of ADR.
+        implicit: bool,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputSpec {
+    pub directory: PathBuf,
+    pub history_every: u64,
+    pub frames_every: u64,
+    pub progress: bool,
+    /// Write `final_positions.csv` and `broken_bonds.csv` at the end.
+    pub final_state: bool,
+    /// A checkpoint every N steps (0: none on a step count).
+    pub checkpoint_every: u64,
+    /// A checkpoint every so many minutes of wall time (0: none on the clock).
+    pub checkpoint_minutes: f64,
+    /// Checkpoints kept on disk (the newest ones).
+    pub checkpoint_keep: usize,
+    /// Resume from this checkpoint file, or the newest in this directory.
+    pub restart: Option<PathBuf>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProbeSpec {
+    pub name: String,
+    pub line: usize,
+    pub at: [f64; 3],
+    /// The run ends at the first history row where this probe's displacement is longer than
+    /// this (`stop_beyond`; infinite when not given).
+    pub stop_beyond: f64,
+}
+
+/// A `[[bar]]` entry: the bar, the initial strain of its own bonds and its line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BarSpec {
+    pub bar: Bar,
+    /// Zero strain: none; see `input/bars.rs`.
+    pub prestrain: Prestrain,
+    pub line: usize,
+}
+
+/// Where `[model]` and each material and its keys are written: what an error from building
+/// the model points at. A [`ModelError`] names its material by index, so `materials` is in
+/// the order of [`Scene::materials`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelLines {
+    /// Deck line of `[model]`.
+    pub model: usize,
+    pub materials: Vec<MaterialLines>,
+}
+
+impl ModelLines {
+    /// The line of the key or the material `e` is about, else of `[model]`.
+    pub fn of(&self, e: &ModelError) -> usize {
+        match e {
+            ModelError::Material { material, .. } => self
+                .materials
+                .get(*material as usize)
+                .map_or(self.model, |m| m.of(e)),
+            ModelError::Model(_) => self.model,
+        }
+    }
+}
+
+/// A deck after checking and unit conversion: everything in the deck's unit system.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub file: String,
+    /// Axes that wrap around.
+    pub periodic: [bool; 3],
+    pub parallel: ParallelSpec,
+    pub title: String,
+    pub units: UnitSystem,
+    pub model: String,
+    pub model_options: Vec<(String, OptionValue)>,
+    /// Where `[model]` and the materials are, for the model's messages.
+    pub model_lines: ModelLines,
+    pub horizon: f64,
+    pub spacing: f64,
+    pub partial_volume: bool,
+    /// Apply the energy surface correction to bond-based models.
+    pub surface_correction: bool,
+    pub materials: Vec<Material>,
+    pub lattice: Lattice,
+    /// The `[[geometry]]` entries in deck order.
+    pub ops: Vec<Located<Op>>,
+    pub bars: Vec<BarSpec>,
+    pub time: TimeSpec,
+    pub boundaries: Vec<BoundarySpec>,
+    pub loads: Vec<LoadSpec>,
+    pub initial: Vec<InitialSpec>,
+    pub output: OutputSpec,
+    pub probes: Vec<ProbeSpec>,
+    /// `[solver]`, at line 0 if the deck leaves it out.
+    pub solver: Located<SolverSpec>,
+}
+
+impl Scene {
+    /// An error from building the model: at the key or the material it is about, else at
+    /// `[model]`.
+    pub fn model_error(&self, e: &ModelError) -> DeckError {
+        self.error(Some(self.model_lines.of(e)), format!("[model] {e}"))
+    }
+
+    /// An error located at `line` of this deck.
+    pub fn error(&self, line: Option<usize>, message: impl Into<String>) -> DeckError {
+        DeckError {
+            file: self.file.clone(),
+            line,
+            message: message.into(),
+        }
+    }
+
+    /// The geometry entries without their lines, as `geometry::build` takes them.
+    pub fn geometry_ops(&self) -> Vec<Op> {
+        self.ops.iter().map(|o| o.item.clone()).collect()
+    }
+
+    /// The bars without their prestrain and lines, as `geometry::build` and the bar
+    /// calibration take them.
+    pub fn geometry_bars(&self) -> Vec<Bar> {
+        self.bars.iter().map(|b| b.bar.clone()).collect()
+    }
+
+    /// Each bar's prestrain, in bar order.
+    pub fn bar_prestrain(&self) -> Vec<Prestrain> {
+        self.bars.iter().map(|b| b.prestrain).collect()
+    }
+}

@@ -1,0 +1,168 @@
+//! `[time]` and `[solver]`: how long to run, the time step and integrator, and whether the
+//! loads are followed by explicit steps or by quasi-static solves.
+
+use super::convert::{Converter, R};
+use super::sections::{SolverSection, TimeSection};
+use super::spec::{CriticalStep, Located, RunLength, SolverSpec, TimeSpec};
+use crate::engine::simulation::Integrator;
+use toml::Spanned;
+
+impl Converter {
+    pub(super) fn time(&self, section: Spanned<TimeSection>) -> R<TimeSpec> {
+        let line = self.line_of(&section);
+        let t = section.into_inner();
+        let length = self.run_length(&t, line)?;
+        let dt = t.dt.map(|d| d.value(self.sys));
+        if let Some(d) = dt {
+            if !(d.is_finite() && d > 0.0) {
+                return self.err(line, format!("[time] dt must be > 0 (got {d})"));
+            }
+        }
+        let safety_factor = t.safety_factor.unwrap_or(0.8);
+        if !(safety_factor > 0.0 && safety_factor <= 1.0) {
+            return self.err(
+                line,
+                format!("[time] safety_factor must lie in (0, 1] (got {safety_factor})"),
+            );
+        }
+        if dt.is_some() && t.safety_factor.is_some() {
+            return self.err(line, "[time] give 'dt' or 'safety_factor', not both");
+        }
+        let critical_step = match t.critical_step.as_deref().unwrap_or("bound") {
+            "bound" => CriticalStep::Bound,
+            "measured" => CriticalStep::Measured,
+            other => {
+                return self.err(
+                    line,
+                    format!(
+                        "[time] critical_step must be \"bound\" or \"measured\" (got \"{other}\")"
+                    ),
+                )
+            }
+        };
+        let static_until = self.static_until(&t, line, length)?;
+        let stop_at_broken_bonds = match t.stop_at_broken_bonds {
+            None => 0,
+            Some(n) if n >= 1 => n as u64,
+            Some(n) => {
+                return self.err(
+                    line,
+                    format!("[time] stop_at_broken_bonds must be a count >= 1 (got {n}); leave it out to run to the end"),
+                )
+            }
+        };
+        let integrator = match t.integrator.as_deref().unwrap_or("verlet") {
+            "verlet" | "velocity-verlet" => Integrator::VelocityVerlet,
+            "euler" | "semi-implicit-euler" => Integrator::SemiImplicitEuler,
+            other => {
+                return self.err(
+                    line,
+                    format!("[time] unknown integrator '{other}' (use \"verlet\" or \"euler\")"),
+                )
+            }
+        };
+        Ok(TimeSpec {
+            line,
+            length,
+            dt,
+            safety_factor,
+            critical_step,
+            static_until,
+            force_dt: t.force_dt.unwrap_or(false),
+            integrator,
+            stop_at_broken_bonds,
+        })
+    }
+
+    /// `steps` or `duration`, exactly one.
+    fn run_length(&self, t: &TimeSection, line: usize) -> R<RunLength> {
+        match (t.steps, t.duration) {
+            (Some(0), None) => self.err(line, "[time] steps must be ≥ 1"),
+            (Some(n), None) => Ok(RunLength::Steps(n)),
+            (None, Some(d)) => {
+                let d = d.value(self.sys);
+                if !(d.is_finite() && d > 0.0) {
+                    return self.err(line, format!("[time] duration must be > 0 (got {d})"));
+                }
+                Ok(RunLength::Duration(d))
+            }
+            (None, None) => self.err(line, "[time] needs 'steps' or 'duration'"),
+            (Some(_), Some(_)) => self.err(line, "[time] give 'steps' or 'duration', not both"),
+        }
+    }
+
+    /// `static_until`: a time > 0 before the end of the run.
+    fn static_until(&self, t: &TimeSection, line: usize, length: RunLength) -> R<Option<f64>> {
+        match t.static_until.map(|d| d.value(self.sys)) {
+            None => Ok(None),
+            Some(s) if !(s.is_finite() && s > 0.0) => self.err(
+                line,
+                format!("[time] static_until must be a time > 0 (got {s})"),
+            ),
+            Some(s) => match length {
+                RunLength::Duration(d) if s >= d => self.err(
+                    line,
+                    format!("[time] static_until = {s:e} is not before the end of the run (duration {d:e}): nothing would be left to step"),
+                ),
+                _ => Ok(Some(s)),
+            },
+        }
+    }
+
+    /// `[solver]`, at line 0 (explicit) when the deck leaves it out.
+    pub(super) fn solver(
+        &self,
+        section: Option<&Spanned<SolverSection>>,
+    ) -> R<Located<SolverSpec>> {
+        let Some(sec) = section else {
+            return Ok(Located {
+                item: SolverSpec::Explicit,
+                line: 0,
+            });
+        };
+        let line = self.line_of(sec);
+        let s = sec.get_ref();
+        let item = match s.kind.as_str() {
+            "explicit" => {
+                if s.load_steps.is_some() || s.tolerance.is_some() || s.max_iterations.is_some() {
+                    return self.err(line, "[solver] load_steps, tolerance and max_iterations belong to kind = \"adr\" or \"implicit\"");
+                }
+                SolverSpec::Explicit
+            }
+            kind @ ("adr" | "implicit") => {
+                let implicit = kind == "implicit";
+                let load_steps = s.load_steps.unwrap_or(10);
+                let tolerance = s.tolerance.unwrap_or(if implicit { 1e-8 } else { 1e-4 });
+                let max_iterations =
+                    s.max_iterations
+                        .unwrap_or(if implicit { 20 } else { 100_000 });
+                if load_steps == 0 || max_iterations == 0 {
+                    return self.err(line, "[solver] load_steps and max_iterations must be ≥ 1");
+                }
+                if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
+                    return self.err(
+                        line,
+                        format!(
+                            "[solver] tolerance must lie in (0, 1), the deck gives {tolerance}"
+                        ),
+                    );
+                }
+                SolverSpec::Relaxation {
+                    load_steps,
+                    tolerance,
+                    max_iterations,
+                    implicit,
+                }
+            }
+            other => {
+                return self.err(
+                    line,
+                    format!(
+                    "[solver] unknown kind '{other}' (use \"explicit\", \"adr\" or \"implicit\")"
+                ),
+                )
+            }
+        };
+        Ok(Located { item, line })
+    }
+}

@@ -1,0 +1,321 @@
+//! From a checked deck to a ready-to-step simulation: geometry → particles → bonds → time step
+//! → boundary conditions and loads.
+
+use crate::engine::bonds::BondList;
+use crate::engine::cells::CellGrid;
+use crate::engine::cells::Domain;
+use crate::engine::particles::Particles;
+use crate::engine::simulation::{stable_time_step, Simulation};
+use crate::input::bars::BarBonds;
+use crate::input::deck::{DeckError, Scene};
+use crate::input::geometry;
+use crate::model::attributes::Attributes;
+use crate::model::{Model, ModelBuild, ModelVisitor};
+use std::time::Instant;
+
+mod place;
+mod time_step;
+
+/// A simulation built from a deck, with what the deck's checks found.
+pub struct Setup<M: Model> {
+    pub sim: Simulation<M>,
+    /// Silling–Askari bound and the particle (store index) that sets it.
+    pub dt_critical: f64,
+    pub dt_critical_particle: usize,
+    /// With `[time] critical_step = "measured"` (explicit runs): the critical step measured on
+    /// the stiffest mode (`spectrum::critical_time_step`; for first-order DOFs still their
+    /// bound), and the force evaluations it took.
+    pub dt_measured: Option<(f64, u64)>,
+    pub steps: u64,
+    /// Probe name and the store index of the particle nearest to it.
+    pub probes: Vec<(String, usize)>,
+    pub seconds: f64,
+    /// The cells the wall method cuts into procCubes (the store is in their order).
+    pub domain: Domain,
+    pub horizon: f64,
+    pub spacing: f64,
+    pub partial_volume: bool,
+    /// Energy surface correction factors gᵢᵏ by store index, if the deck asks for them.
+    pub correction: Option<Vec<[f64; 3]>>,
+    /// Explicit stepping, or relaxation to equilibrium at each load step.
+    pub solver: crate::input::deck::SolverSpec,
+    /// Calibration factors and prestrain of the bars' own bonds.
+    pub bars: BarBonds,
+}
+
+impl<M: Model> Setup<M> {
+    /// The critical step Δt was chosen against: the measured one if the deck asked for it,
+    /// else the Silling–Askari bound.
+    pub fn dt_limit(&self) -> f64 {
+        self.dt_measured.map_or(self.dt_critical, |(dt, _)| dt)
+    }
+}
+
+/// Builds the model named by the deck and hands it to `visitor`.
+pub fn with_model<V: ModelVisitor>(scene: &Scene, visitor: V) -> Result<V::Output, DeckError> {
+    let build = ModelBuild {
+        materials: &scene.materials,
+        horizon: scene.horizon,
+        spacing: scene.spacing,
+        options: &scene.model_options,
+    };
+    crate::models::visit(&scene.model, &build, visitor).map_err(|e| scene.model_error(&e))
+}
+
+/// Builds the simulation of `scene` with `model`: the particles in cell order, their bonds,
+/// the time step, then what the deck places on the particles, and the first forces.
+pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
+    let start = Instant::now();
+    let (mut particles, cloud_bar, domain, gid_to_index) = particles(&model, scene)?;
+    let (bonds, correction, bars) = bonds(&model, &mut particles, scene, cloud_bar)?;
+    let (dt_critical, dt_critical_particle) = stable_time_step(&model, &particles, &bonds);
+    if dt_critical.is_nan() || dt_critical <= 0.0 {
+        return Err(scene.error(
+            None,
+            format!("the stable time step is {dt_critical:e}: check the materials' stiffness and density"),
+        ));
+    }
+    if !dt_critical.is_finite() {
+        return Err(scene.error(
+            None,
+            "no particle has a bond: the horizon is too small for the particle spacing",
+        ));
+    }
+    place::initial_state(&mut particles, scene, &gid_to_index)?;
+    let constraints = place::constraints(&particles, scene, &gid_to_index)?;
+    let loads = place::loads(&particles, scene, &gid_to_index)?;
+    let probes = place::probes(&particles, scene);
+
+    let mut sim = Simulation::new(
+        model,
+        particles,
+        bonds,
+        scene.time.safety_factor * dt_critical,
+    );
+    sim.constraints = constraints;
+    sim.loads = loads;
+    sim.integrator = scene.time.integrator;
+    let stepping = time_step::stepping(&mut sim, scene, dt_critical, dt_critical_particle)?;
+    let dt = stepping.dt;
+    sim.dt = dt;
+    for c in &sim.constraints {
+        c.set_velocity(&mut sim.particles, 0.0, dt);
+    }
+    sim.compute_forces();
+    let seconds = start.elapsed().as_secs_f64();
+    sim.timing = crate::engine::timing::Timing::default();
+    sim.timing
+        .add(crate::engine::timing::Phase::Setup, start.elapsed());
+    Ok(Setup {
+        sim,
+        dt_critical,
+        dt_critical_particle,
+        dt_measured: stepping.dt_measured,
+        steps: stepping.steps,
+        probes,
+        seconds,
+        domain,
+        horizon: scene.horizon,
+        spacing: scene.spacing,
+        partial_volume: scene.partial_volume,
+        correction,
+        solver: scene.solver.item.clone(),
+        bars,
+    })
+}
+
+/// The deck's particles, stored in cell order so that bond partners are near each other in
+/// memory and the wall method finds each cell's particles in one run; with each particle's
+/// bar by global id, the cells and the store index of each global id.
+#[allow(clippy::type_complexity)]
+fn particles<M: Model>(
+    model: &M,
+    scene: &Scene,
+) -> Result<(Particles<M>, Vec<u32>, Domain, Vec<u32>), DeckError> {
+    let ops = scene.geometry_ops();
+    let cloud = geometry::build(&scene.lattice, &ops, &scene.geometry_bars()).map_err(|e| {
+        // An empty scene is blamed on the last subtraction, the usual culprit.
+        let subtract = |o: &geometry::Op| e.empty && matches!(o, geometry::Op::Subtract { .. });
+        let last_subtract = ops.iter().rposition(subtract).map(|k| scene.ops[k].line);
+        let line = e
+            .entry
+            .map(|k| scene.ops[k].line)
+            .or(e.bar.map(|k| scene.bars[k].line))
+            .or(last_subtract);
+        scene.error(line, e.message.clone())
+    })?;
+    let domain = domain(&cloud.position, scene)?;
+    let (_, _, order) = domain.grid.bin(&cloud.position);
+    let gid: Vec<u32> = order.clone();
+    let x0 = order.iter().map(|&g| cloud.position[g as usize]).collect();
+    let volume = order.iter().map(|&g| cloud.volume[g as usize]).collect();
+    let material = order.iter().map(|&g| cloud.material[g as usize]).collect();
+    let mut gid_to_index = vec![0u32; gid.len()];
+    for (i, &g) in gid.iter().enumerate() {
+        gid_to_index[g as usize] = i as u32;
+    }
+    let particles = Particles::new(model, gid, x0, volume, material);
+    Ok((particles, cloud.bar, domain, gid_to_index))
+}
+
+/// The bonds within the horizon, with the surface correction if the deck asks for it and the
+/// bars' calibration and prestrain applied; `bar_of` is each particle's bar by global id.
+#[allow(clippy::type_complexity)]
+fn bonds<M: Model>(
+    model: &M,
+    particles: &mut Particles<M>,
+    scene: &Scene,
+    bar_of: Vec<u32>,
+) -> Result<(BondList<M::Bond>, Option<Vec<[f64; 3]>>, BarBonds), DeckError> {
+    let mut bonds = BondList::<M::Bond>::find(
+        &particles.x0,
+        particles.n_owned,
+        scene.horizon,
+        scene.spacing,
+        scene.partial_volume,
+    );
+    crate::engine::forces::add_bond_fixed(model, particles, &bonds);
+    let correction = if scene.surface_correction {
+        if <M::State as Attributes>::LEN > 0 {
+            return Err(scene.error(
+                Some(scene.model_lines.model),
+                format!("[model] surface_correction = \"energy\" is for bond-based models; model '{}' is state-based (its weighted volume already uses the discrete family)", M::NAME),
+            ));
+        }
+        let g = crate::engine::correction::energy_factors(model, particles, &bonds);
+        let bar = |i: usize| bar_of[particles.gid[i] as usize];
+        crate::engine::correction::correct_bonds(
+            &mut bonds,
+            &particles.x0,
+            |i| g[i],
+            |i, j| bar(i) != geometry::NOT_A_BAR && bar(i) == bar(j),
+        );
+        Some(g)
+    } else {
+        None
+    };
+    // Particles in one place (overlapping bars, say) would make a bond of length zero.
+    if let Some((i, j, _)) = bonds
+        .iter()
+        .find(|&(_, _, b)| bonds.geom[b].length < 1e-6 * scene.spacing)
+    {
+        return Err(scene.error(
+            None,
+            format!(
+                "particles {} and {} coincide (at {:?} and {:?}): overlapping bars or shapes put two particles in one place",
+                particles.gid[i], particles.gid[j], particles.x0[i], particles.x0[j]
+            ),
+        ));
+    }
+    let bars = bar_bonds(model, particles, &bonds, scene, bar_of)?;
+    bars.apply(model, &mut bonds, &particles.x0, |i| particles.gid[i]);
+    Ok((bonds, correction, bars))
+}
+
+/// The bars' calibration factors (bond-based models) and prestrained bond histories; see
+/// `input/bars.rs`. `bar_of` is by global id.
+fn bar_bonds<M: Model>(
+    model: &M,
+    particles: &mut Particles<M>,
+    bonds: &BondList<M::Bond>,
+    scene: &Scene,
+    bar_of: Vec<u32>,
+) -> Result<BarBonds, DeckError> {
+    if scene.bars.is_empty() {
+        return Ok(BarBonds::default());
+    }
+    let bars = scene.geometry_bars();
+    let mut modulus = Vec::with_capacity(bars.len());
+    for b in &bars {
+        let given = scene.materials[b.material as usize]
+            .positive("youngs_modulus", crate::model::Dimension::STRESS)
+            .map_err(|e| scene.model_error(&e))?;
+        modulus.push(given.unwrap_or_else(|| {
+            let (l, mu) = model.lame(b.material);
+            mu * (3.0 * l + 2.0 * mu) / (l + mu)
+        }));
+    }
+    let factor = if <M::State as Attributes>::LEN == 0 {
+        crate::input::bars::calibrate(
+            model,
+            particles,
+            bonds,
+            &bars,
+            &modulus,
+            &bar_of,
+            scene.horizon,
+        )
+    } else {
+        vec![1.0; scene.bars.len()]
+    };
+    for (k, b) in scene.bars.iter().enumerate() {
+        if b.prestrain.strain != 0.0 {
+            let law = model.law(b.bar.material, b.bar.material);
+            model
+                .prestrained(&law, b.prestrain.strain)
+                .map_err(|m| scene.error(Some(b.line), format!("bar {k}: {m}")))?;
+        }
+    }
+    Ok(BarBonds {
+        bar_of,
+        factor,
+        bars,
+        prestrain: scene.bar_prestrain(),
+    })
+}
+
+/// Cells of side ≥ the horizon over the scene. A periodic axis spans the lattice box (particle
+/// positions ± half a spacing) exactly, so that its cells tile one period.
+fn domain(points: &[[f64; 3]], scene: &Scene) -> Result<Domain, DeckError> {
+    // With shuffling, bonds are found from current cells: the skin keeps a stretched bond
+    // between neighbouring cells.
+    let min_cell = scene.horizon * (1.0 + scene.parallel.skin);
+    let mut grid = CellGrid::covering(points, min_cell);
+    let mut period = [0.0; 3];
+    for a in 0..3 {
+        if !scene.periodic[a] {
+            continue;
+        }
+        let lo = points.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min);
+        let hi = points
+            .iter()
+            .map(|p| p[a])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let length = hi - lo + scene.spacing;
+        let n = (length / (min_cell * (1.0 + 1e-9))).floor() as usize;
+        if n < 3 {
+            return Err(scene.error(
+                None,
+                format!(
+                    "[lattice] periodic axis {} is {:.4e} long; it must be longer than three horizons{} ({:.4e}) to hold three cells; make the body longer along it or drop the axis from 'periodic'",
+                    ["x", "y", "z"][a],
+                    length,
+                    if scene.parallel.skin > 0.0 { " with the shuffle skin" } else { "" },
+                    3.0 * min_cell
+                ),
+            ));
+        }
+        grid.origin[a] = lo - 0.5 * scene.spacing;
+        grid.dims[a] = n;
+        grid.size[a] = length / n as f64;
+        period[a] = length;
+    }
+    Ok(Domain {
+        grid,
+        periodic: scene.periodic,
+        period,
+    })
+}
+
+/// Builds model `M` from the deck's materials and horizon (the deck's model name is not
+/// consulted): for tests and tools that know their model at compile time.
+pub fn build_as<M: Model>(scene: &Scene) -> Result<Setup<M>, DeckError> {
+    let b = ModelBuild {
+        materials: &scene.materials,
+        horizon: scene.horizon,
+        spacing: scene.spacing,
+        options: &scene.model_options,
+    };
+    let model = M::build(&b).map_err(|e| scene.model_error(&e))?;
+    build(model, scene)
+}
