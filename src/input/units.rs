@@ -217,13 +217,17 @@ const UNITS: &[(&str, f64, Dim)] = &[
 
 /// Parse "<number> <unit expression>" into (value in SI, dimension).
 pub fn parse_quantity(text: &str) -> Result<(f64, Dim), String> {
-    parse_parts(text).map(|(num, factor, dim)| (num * factor, dim))
+    parse_parts(text, None).map(|(num, factor, dim)| (num * factor, dim))
 }
 
 /// (number, SI size of its unit, dimension), kept apart so [`Quantity`] can
-/// convert without a round trip through SI.
-fn parse_parts(text: &str) -> Result<(f64, f64, Dim), String> {
-    let ex = "expected a number followed by a unit";
+/// convert without a round trip through SI. A text that is not a number and a unit is told
+/// what is expected, with `example` if one is given.
+fn parse_parts(text: &str, example: Option<&str>) -> Result<(f64, f64, Dim), String> {
+    let ex = match example {
+        Some(e) => format!("expected a number followed by a unit, e.g. \"{e}\""),
+        None => "expected a number followed by a unit".to_string(),
+    };
     let (num, rest) = split_number(text.trim())
         .ok_or_else(|| format!("\"{text}\" does not start with a number; {ex}"))?;
     if rest.trim().is_empty() {
@@ -352,13 +356,7 @@ fn parse_as(s: &str, dim: Dim) -> Result<Repr, String> {
     if let Ok(v) = s.trim().parse::<f64>() {
         return Ok(Repr::Plain(v));
     }
-    let (v, factor, found) = parse_parts(s).map_err(|e| {
-        if e.contains("expected a number followed by a unit") {
-            format!("{e}, e.g. \"{}\"", dim.example())
-        } else {
-            e
-        }
-    })?;
+    let (v, factor, found) = parse_parts(s, Some(&dim.example()))?;
     if found != dim {
         return Err(mismatch(dim, s, found));
     }
