@@ -25,7 +25,7 @@
 //! [`crate::engine::spectrum::LANCZOS_STEPS`] force evaluations on the undeformed scene, with K applied as force
 //! differences. The masses are then b_i · λ_max / [`TARGET_EIGENVALUE`], 7/8 of the stability
 //! limit; stiffness only falls as bonds break, and should the iterations diverge all the same,
-//! `relax_step` repeats the load step with doubled masses. The estimate is made once,
+//! `Adr::load_step` repeats the load step with doubled masses. The estimate is made once,
 //! serially, before the scene is cut into procCubes, so every layout and a restart get the same
 //! masses (a doubling is not carried into a restart).
 
@@ -36,6 +36,7 @@ use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model};
 use crate::parallel::comm::Reduce;
 use crate::parallel::Cube;
+use crate::solve::Solver;
 use std::time::Instant;
 
 /// The book's safety factor on the Gershgorin mass (Madenci & Oterkus 2014), used only when the
@@ -45,7 +46,7 @@ const MASS_SAFETY: f64 = 5.0;
 /// The largest eigenvalue of M⁻¹K the masses are scaled to: 7/8 of the stability limit 4 of
 /// the pseudo time step 1. The estimate is converged (the same four digits at 30, 60 and 120
 /// steps on the suite's cantilevers) and stiffness only falls as bonds break, so the margin is
-/// for what the estimate cannot see; `relax_step` doubles the masses if the iterations diverge.
+/// for what the estimate cannot see; `Adr::load_step` doubles the masses if the iterations diverge.
 pub const TARGET_EIGENVALUE: f64 = 3.5;
 
 /// Damping used when the stiffness estimate asks for more than critical (both reference codes).
@@ -142,188 +143,223 @@ pub fn zero_velocities<M: Model>(p: &mut Particles<M>) {
     }
 }
 
-impl<M: Model> Cube<M> {
-    /// The start of a quasi-static load step (relaxation or the implicit solve): supports to
-    /// their positions at the end of the step (a displacement history lands exactly; a velocity
-    /// moves them by v·Δt), free particles held, the clock to the step's end.
-    pub fn begin_load_step(&mut self) {
-        let n = self.sim.particles.n_owned;
-        let (t0, dt) = (self.sim.time, self.sim.dt);
-        let start = Instant::now();
-        zero_velocities(&mut self.sim.particles);
-        for c in &self.sim.constraints {
-            c.set_drift_velocity(&mut self.sim.particles, t0, dt);
+/// The start of a quasi-static load step (relaxation or the implicit solve): supports to
+/// their positions at the end of the step (a displacement history lands exactly; a velocity
+/// moves them by v·Δt), free particles held, the clock to the step's end.
+pub fn begin_load_step<M: Model>(cube: &mut Cube<M>) {
+    let n = cube.sim.particles.n_owned;
+    let (t0, dt) = (cube.sim.time, cube.sim.dt);
+    let start = Instant::now();
+    zero_velocities(&mut cube.sim.particles);
+    for c in &cube.sim.constraints {
+        c.set_drift_velocity(&mut cube.sim.particles, t0, dt);
+    }
+    let sim = &mut cube.sim;
+    for a in &mut sim.particles.alter[..n] {
+        sim.model.drift(a, dt);
+    }
+    zero_velocities(&mut cube.sim.particles);
+    cube.sim.time = t0 + dt;
+    cube.sim.step += 1;
+    cube.sim.timing.lap(Phase::Integration, start);
+}
+
+/// Adaptive dynamic relaxation (Kilic & Madenci 2010, docs/theory.md §5) with these
+/// fictitious masses; they double, for this and every later load step, when a step diverges.
+pub struct Adr {
+    pub mass: FictitiousMass,
+    pub tolerance: f64,
+    pub max_iterations: u64,
+    /// Whether this worker reports a divergence (the root only).
+    pub report: bool,
+    mass_scale: f64,
+}
+
+impl Adr {
+    pub fn new(mass: FictitiousMass, tolerance: f64, max_iterations: u64, report: bool) -> Self {
+        Adr {
+            mass,
+            tolerance,
+            max_iterations,
+            report,
+            mass_scale: 1.0,
         }
-        let sim = &mut self.sim;
-        for a in &mut sim.particles.alter[..n] {
-            sim.model.drift(a, dt);
-        }
-        zero_velocities(&mut self.sim.particles);
-        self.sim.time = t0 + dt;
-        self.sim.step += 1;
-        self.sim.timing.lap(Phase::Integration, start);
     }
 
     /// One load step of adaptive dynamic relaxation: supports and loads move to time
-    /// `sim.time + sim.dt`, then the particles relax to equilibrium. `mass_by_gid` is
-    /// [`fictitious_mass`], times `mass_scale`. If the iterations diverge (the fictitious masses
-    /// too light for a stiffness the estimate missed) the step starts again from where it
-    /// began, bonds and history restored, with `mass_scale` doubled for this and every later
-    /// step. Every worker must call it (the divergence test is on the reduced residual, so all
-    /// decide alike).
-    pub fn relax_step(
-        &mut self,
-        mass_by_gid: &[f64],
-        mass_scale: &mut f64,
-        tolerance: f64,
-        max_iterations: u64,
-    ) -> Relaxed {
+    /// `sim.time + sim.dt`, then the particles relax to equilibrium, with the fictitious masses
+    /// times the mass scale. If the iterations diverge (the fictitious masses too light for a
+    /// stiffness the estimate missed) the step starts again from where it began, bonds and
+    /// history restored, with the mass scale doubled for this and every later step. Every
+    /// worker must call it (the divergence test is on the reduced residual, so all decide
+    /// alike).
+    pub fn load_step<M: Model>(&mut self, cube: &mut Cube<M>) -> Relaxed {
         let n2 = second_order::<M>();
-        let n = self.sim.particles.n_owned;
-        self.begin_load_step();
+        let n = cube.sim.particles.n_owned;
+        begin_load_step(cube);
         let start = Instant::now();
         let saved = (
-            self.sim.particles.alter[..n].to_vec(),
-            self.sim.bonds.broken.clone(),
-            self.sim.bonds.history.clone(),
+            cube.sim.particles.alter[..n].to_vec(),
+            cube.sim.bonds.broken.clone(),
+            cube.sim.bonds.history.clone(),
         );
-        self.sim.timing.lap(Phase::Integration, start);
+        cube.sim.timing.lap(Phase::Integration, start);
         let mut spent = 0;
         loop {
             let t = Instant::now();
             let lambda: Vec<f64> = (0..n)
                 .flat_map(|i| {
-                    let g = self.sim.particles.gid[i] as usize;
-                    mass_by_gid[g * n2..(g + 1) * n2]
+                    let g = cube.sim.particles.gid[i] as usize;
+                    self.mass.by_gid[g * n2..(g + 1) * n2]
                         .iter()
-                        .map(|m| m * *mass_scale)
+                        .map(|m| m * self.mass_scale)
                 })
                 .collect();
-            self.sim.timing.lap(Phase::Integration, t);
-            let mut r = self.relax(&lambda, tolerance, max_iterations.saturating_sub(spent));
+            cube.sim.timing.lap(Phase::Integration, t);
+            let left = self.max_iterations.saturating_sub(spent);
+            let mut r = relax(cube, &lambda, self.tolerance, left);
             spent += r.iterations;
             r.iterations = spent;
-            if !r.diverged || spent >= max_iterations || *mass_scale > 1e6 {
+            if !r.diverged || spent >= self.max_iterations || self.mass_scale > 1e6 {
                 return r;
             }
-            self.sim.particles.alter[..n].copy_from_slice(&saved.0);
-            self.sim.bonds.broken.clone_from(&saved.1);
-            self.sim.bonds.history.clone_from(&saved.2);
-            *mass_scale *= 2.0;
+            cube.sim.particles.alter[..n].copy_from_slice(&saved.0);
+            cube.sim.bonds.broken.clone_from(&saved.1);
+            cube.sim.bonds.history.clone_from(&saved.2);
+            self.mass_scale *= 2.0;
         }
     }
+}
 
-    /// The iterations of one load step with masses `lambda` (owned DOFs in order), at most
-    /// `max_iterations` force evaluations; stops early when they diverge.
-    fn relax(&mut self, lambda: &[f64], tolerance: f64, max_iterations: u64) -> Relaxed {
-        let n2 = second_order::<M>();
-        let n = self.sim.particles.n_owned;
-        let mut iterations = 1;
-        self.compute_forces();
-        // Forces of this and of the previous iteration, two buffers swapped: no allocation per
-        // iteration.
-        let mut previous: Vec<f64> = Vec::with_capacity(n * n2);
-        self.owned_forces(n2, &mut previous);
-        let mut force: Vec<f64> = Vec::with_capacity(n * n2);
-        // u̇^½ = F⁰ / (2λ) (pseudo time step 1).
+impl<M: Model> Solver<M> for Adr {
+    fn advance(&mut self, cube: &mut Cube<M>, step: u64) -> Result<Option<Relaxed>, String> {
+        let before = self.mass_scale;
+        let r = self.load_step(cube);
+        if self.mass_scale != before && self.report {
+            eprintln!(
+                "warning    relaxation diverged at step {step}: repeated with the fictitious masses ×{}{}",
+                self.mass_scale,
+                if r.diverged { ", and diverged again" } else { "" }
+            );
+        }
+        Ok(Some(r))
+    }
+}
+
+/// The iterations of one load step with masses `lambda` (owned DOFs in order), at most
+/// `max_iterations` force evaluations; stops early when they diverge.
+fn relax<M: Model>(
+    cube: &mut Cube<M>,
+    lambda: &[f64],
+    tolerance: f64,
+    max_iterations: u64,
+) -> Relaxed {
+    let n2 = second_order::<M>();
+    let n = cube.sim.particles.n_owned;
+    let mut iterations = 1;
+    cube.compute_forces();
+    // Forces of this and of the previous iteration, two buffers swapped: no allocation per
+    // iteration.
+    let mut previous: Vec<f64> = Vec::with_capacity(n * n2);
+    owned_forces(cube, n2, &mut previous);
+    let mut force: Vec<f64> = Vec::with_capacity(n * n2);
+    // u̇^½ = F⁰ / (2λ) (pseudo time step 1).
+    {
+        let p = &mut cube.sim.particles;
+        for i in 0..n {
+            let a = p.alter[i].as_mut_slice();
+            for k in 0..n2 {
+                a[n2 + k] = previous[i * n2 + k] / (2.0 * lambda[i * n2 + k]);
+            }
+        }
+    }
+    let mut residual;
+    let mut diverged;
+    loop {
+        let t = Instant::now();
         {
-            let p = &mut self.sim.particles;
-            for i in 0..n {
-                let a = p.alter[i].as_mut_slice();
-                for k in 0..n2 {
-                    a[n2 + k] = previous[i * n2 + k] / (2.0 * lambda[i * n2 + k]);
-                }
+            let sim = &mut cube.sim;
+            for a in &mut sim.particles.alter[..n] {
+                sim.model.drift(a, 1.0);
             }
         }
-        let mut residual;
-        let mut diverged;
-        loop {
-            let t = Instant::now();
-            {
-                let sim = &mut self.sim;
-                for a in &mut sim.particles.alter[..n] {
-                    sim.model.drift(a, 1.0);
-                }
-            }
-            self.sim.timing.lap(Phase::Integration, t);
-            self.compute_forces();
-            iterations += 1;
-            let t = Instant::now();
-            self.owned_forces(n2, &mut force);
-            // uᵀ¹Ku, uᵀu, |F|², and the scale: applied loads and support reactions.
-            let p = &self.sim.particles;
-            let mut sums = [0.0f64; 3];
-            for i in 0..n {
-                let a = p.alter[i].as_slice();
-                for k in 0..n2 {
-                    let idx = i * n2 + k;
-                    let v = a[n2 + k];
-                    // The damping follows the translations: a Rayleigh quotient that mixed
-                    // lengths and angles would weigh them by the choice of units.
-                    if k < 3 {
-                        let u = displacement(p, i, k);
-                        if v != 0.0 {
-                            let stiffness = -(force[idx] - previous[idx]) / (lambda[idx] * v);
-                            sums[0] += u * stiffness * u;
-                        }
-                        sums[1] += u * u;
+        cube.sim.timing.lap(Phase::Integration, t);
+        cube.compute_forces();
+        iterations += 1;
+        let t = Instant::now();
+        owned_forces(cube, n2, &mut force);
+        // uᵀ¹Ku, uᵀu, |F|², and the scale: applied loads and support reactions.
+        let p = &cube.sim.particles;
+        let mut sums = [0.0f64; 3];
+        for i in 0..n {
+            let a = p.alter[i].as_slice();
+            for k in 0..n2 {
+                let idx = i * n2 + k;
+                let v = a[n2 + k];
+                // The damping follows the translations: a Rayleigh quotient that mixed
+                // lengths and angles would weigh them by the choice of units.
+                if k < 3 {
+                    let u = displacement(p, i, k);
+                    if v != 0.0 {
+                        let stiffness = -(force[idx] - previous[idx]) / (lambda[idx] * v);
+                        sums[0] += u * stiffness * u;
                     }
-                    sums[2] += force[idx] * force[idx];
+                    sums[1] += u * u;
                 }
+                sums[2] += force[idx] * force[idx];
             }
-            // Each procCube holds its share of every load's total and support's reaction:
-            // summed, they are the whole scene's.
-            let mut all: Vec<f64> = sums.to_vec();
-            for l in &self.sim.loads {
-                all.extend_from_slice(&l.total(self.sim.time));
-            }
-            for c in &self.sim.constraints {
-                all.extend_from_slice(&c.reaction);
-            }
-            self.team().reduce(&mut all, Reduce::Sum);
-            let scale = all[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
-            residual = all[2].sqrt() / scale.max(f64::MIN_POSITIVE);
-            // A crack can raise the residual to about the applied forces, never a thousand
-            // times over: that is the exponential growth of an unstable pseudo time step.
-            diverged = residual.is_nan() || residual > DIVERGED;
-            if residual <= tolerance || iterations >= max_iterations || diverged {
-                self.sim.timing.lap(Phase::Integration, t);
-                break;
-            }
-            let ratio = all[0] / all[1].max(f64::MIN_POSITIVE);
-            let mut c = if ratio > 0.0 { 2.0 * ratio.sqrt() } else { 0.0 };
-            if c > 2.0 {
-                c = DAMPING_CAP;
-            }
-            // u̇ⁿ⁺½ = [(2 − c)u̇ⁿ⁻½ + 2Fⁿ/λ] / (2 + c).
-            let p = &mut self.sim.particles;
-            for i in 0..n {
-                let a = p.alter[i].as_mut_slice();
-                for k in 0..n2 {
-                    let idx = i * n2 + k;
-                    a[n2 + k] =
-                        ((2.0 - c) * a[n2 + k] + 2.0 * force[idx] / lambda[idx]) / (2.0 + c);
-                }
-            }
-            std::mem::swap(&mut previous, &mut force);
-            self.sim.timing.lap(Phase::Integration, t);
         }
-        zero_velocities(&mut self.sim.particles);
-        Relaxed {
-            iterations,
-            residual,
-            converged: residual <= tolerance,
-            diverged,
+        // Each procCube holds its share of every load's total and support's reaction:
+        // summed, they are the whole scene's.
+        let mut all: Vec<f64> = sums.to_vec();
+        for l in &cube.sim.loads {
+            all.extend_from_slice(&l.total(cube.sim.time));
         }
+        for c in &cube.sim.constraints {
+            all.extend_from_slice(&c.reaction);
+        }
+        cube.team().reduce(&mut all, Reduce::Sum);
+        let scale = all[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
+        residual = all[2].sqrt() / scale.max(f64::MIN_POSITIVE);
+        // A crack can raise the residual to about the applied forces, never a thousand
+        // times over: that is the exponential growth of an unstable pseudo time step.
+        diverged = residual.is_nan() || residual > DIVERGED;
+        if residual <= tolerance || iterations >= max_iterations || diverged {
+            cube.sim.timing.lap(Phase::Integration, t);
+            break;
+        }
+        let ratio = all[0] / all[1].max(f64::MIN_POSITIVE);
+        let mut c = if ratio > 0.0 { 2.0 * ratio.sqrt() } else { 0.0 };
+        if c > 2.0 {
+            c = DAMPING_CAP;
+        }
+        // u̇ⁿ⁺½ = [(2 − c)u̇ⁿ⁻½ + 2Fⁿ/λ] / (2 + c).
+        let p = &mut cube.sim.particles;
+        for i in 0..n {
+            let a = p.alter[i].as_mut_slice();
+            for k in 0..n2 {
+                let idx = i * n2 + k;
+                a[n2 + k] = ((2.0 - c) * a[n2 + k] + 2.0 * force[idx] / lambda[idx]) / (2.0 + c);
+            }
+        }
+        std::mem::swap(&mut previous, &mut force);
+        cube.sim.timing.lap(Phase::Integration, t);
     }
+    zero_velocities(&mut cube.sim.particles);
+    Relaxed {
+        iterations,
+        residual,
+        converged: residual <= tolerance,
+        diverged,
+    }
+}
 
-    /// Forces on the second-order DOFs of owned particles (zero on supported DOFs).
-    fn owned_forces(&self, n2: usize, out: &mut Vec<f64>) {
-        let p = &self.sim.particles;
-        out.clear();
-        for f in &p.force[..p.n_owned] {
-            out.extend_from_slice(&f.as_slice()[..n2]);
-        }
+/// Forces on the second-order DOFs of owned particles (zero on supported DOFs).
+fn owned_forces<M: Model>(cube: &Cube<M>, n2: usize, out: &mut Vec<f64>) {
+    let p = &cube.sim.particles;
+    out.clear();
+    for f in &p.force[..p.n_owned] {
+        out.extend_from_slice(&f.as_slice()[..n2]);
     }
 }
 

@@ -24,7 +24,8 @@ use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model, Side};
 use crate::parallel::comm::Reduce;
 use crate::parallel::Cube;
-use crate::solve::adr::Relaxed;
+use crate::solve::adr::{begin_load_step, zero_velocities, Relaxed};
+use crate::solve::Solver;
 use faer::prelude::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use std::time::Instant;
@@ -320,188 +321,209 @@ fn factor(
     })
 }
 
-impl<M: Model> Cube<M> {
-    /// Assembles and factors the tangent stiffness at the current state. Bonds, their
-    /// history and the forces are left as they were.
-    pub fn assemble_tangent(&mut self) -> Result<Tangent, String> {
-        let start = Instant::now();
-        let n2 = second_order::<M>();
-        let n = self.sim.particles.n_owned;
-        if self.layout.domain.periodic.iter().any(|&p| p) {
-            return Err("the implicit solve does not handle periodic axes (it finds who feels whom from reference positions)".into());
-        }
-        if self.sim.particles.len() != n || self.wall.transport().size() != 1 {
-            return Err("the implicit solve runs on one procCube (--threads 1, no mpirun): the tangent is assembled and factored in one process".into());
-        }
-        // Supported DOFs.
-        let mut free = 0;
-        let index: Vec<usize> = (self.sim.free_dofs().iter())
-            .map(|&f| {
-                if f {
-                    free += 1;
-                    free - 1
-                } else {
-                    usize::MAX
-                }
-            })
-            .collect();
-        // Reach of a particle's force: the longest bond, twice over a state pass.
-        let sim = &self.sim;
-        let (mut longest, mut shortest) = (0.0f64, f64::INFINITY);
-        for g in &sim.bonds.geom {
-            longest = longest.max(g.length);
-            shortest = shortest.min(g.length);
-        }
-        if longest == 0.0 {
-            return Err("the implicit solve needs bonds: the scene has none".into());
-        }
-        if <M::State as Attributes>::LEN == 0 {
-            let triplets = bond_blocks(
-                &sim.model,
-                &sim.particles,
-                &sim.bonds,
-                &index,
-                PERTURBATION * shortest,
-            );
-            let broken = sim.bonds.broken_count();
-            return factor(triplets, index, free, broken, 4 * n2 as u64, 0, start);
-        }
-        self.state_tangent(index, free, shortest, 2.0 * longest, start)
+/// Assembles and factors the tangent stiffness at the current state. Bonds, their
+/// history and the forces are left as they were.
+pub fn assemble_tangent<M: Model>(cube: &mut Cube<M>) -> Result<Tangent, String> {
+    let start = Instant::now();
+    let n2 = second_order::<M>();
+    let n = cube.sim.particles.n_owned;
+    if cube.layout.domain.periodic.iter().any(|&p| p) {
+        return Err("the implicit solve does not handle periodic axes (it finds who feels whom from reference positions)".into());
     }
-
-    /// The tangent of a state-based model by central differences of the force: particles of
-    /// one colour (farther apart than `reach`, which a force's dependence spans: a state sums
-    /// over a family, so two bond lengths) are nudged together, one DOF at a time.
-    fn state_tangent(
-        &mut self,
-        index: Vec<usize>,
-        free: usize,
-        shortest: f64,
-        reach: f64,
-        start: Instant,
-    ) -> Result<Tangent, String> {
-        let n2 = second_order::<M>();
-        let n = self.sim.particles.n_owned;
-        let colours = colour(&self.sim.particles.x0[..n], reach);
-        let neighbours = Neighbours::new(&self.sim.particles.x0[..n], reach);
-        let saved_alter = self.sim.particles.alter.clone();
-        let saved_broken = self.sim.bonds.broken.clone();
-        let broken = saved_broken.iter().filter(|&&b| b).count();
-        let saved_history = self.sim.bonds.history.clone();
-        let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
-        let mut plus = vec![0.0; n * n2];
-        let mut rows = Vec::new();
-        let mut evaluations = 0u64;
-        let owned = |p: &Particles<M>, out: &mut Vec<f64>| {
-            for (i, f) in p.force[..n].iter().enumerate() {
-                out[i * n2..(i + 1) * n2].copy_from_slice(&f.as_slice()[..n2]);
+    if cube.sim.particles.len() != n || cube.wall.transport().size() != 1 {
+        return Err("the implicit solve runs on one procCube (--threads 1, no mpirun): the tangent is assembled and factored in one process".into());
+    }
+    // Supported DOFs.
+    let mut free = 0;
+    let index: Vec<usize> = (cube.sim.free_dofs().iter())
+        .map(|&f| {
+            if f {
+                free += 1;
+                free - 1
+            } else {
+                usize::MAX
             }
-        };
-        let mut minus = vec![0.0; n * n2];
-        for members in &colours {
-            for k in 0..n2 {
-                let h = if k < 3 {
-                    PERTURBATION * shortest
-                } else {
-                    PERTURBATION
-                };
-                let free_members: Vec<usize> = members
-                    .iter()
-                    .copied()
-                    .filter(|&i| index[i * n2 + k] != usize::MAX)
-                    .collect();
-                if free_members.is_empty() {
-                    continue;
-                }
-                for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
-                    let sim = &mut self.sim;
-                    for &i in &free_members {
-                        sim.particles.alter[i] = saved_alter[i];
-                        nudge(&sim.model, &mut sim.particles.alter[i], k, sign * h);
-                    }
-                    sim.compute_forces_with(&mut self.wall);
-                    evaluations += 1;
-                    owned(&sim.particles, out);
-                    for &i in &free_members {
-                        sim.particles.alter[i] = saved_alter[i];
-                    }
-                }
+        })
+        .collect();
+    // Reach of a particle's force: the longest bond, twice over a state pass.
+    let sim = &cube.sim;
+    let (mut longest, mut shortest) = (0.0f64, f64::INFINITY);
+    for g in &sim.bonds.geom {
+        longest = longest.max(g.length);
+        shortest = shortest.min(g.length);
+    }
+    if longest == 0.0 {
+        return Err("the implicit solve needs bonds: the scene has none".into());
+    }
+    if <M::State as Attributes>::LEN == 0 {
+        let triplets = bond_blocks(
+            &sim.model,
+            &sim.particles,
+            &sim.bonds,
+            &index,
+            PERTURBATION * shortest,
+        );
+        let broken = sim.bonds.broken_count();
+        return factor(triplets, index, free, broken, 4 * n2 as u64, 0, start);
+    }
+    state_tangent(cube, index, free, shortest, 2.0 * longest, start)
+}
+
+/// The tangent of a state-based model by central differences of the force: particles of
+/// one colour (farther apart than `reach`, which a force's dependence spans: a state sums
+/// over a family, so two bond lengths) are nudged together, one DOF at a time.
+fn state_tangent<M: Model>(
+    cube: &mut Cube<M>,
+    index: Vec<usize>,
+    free: usize,
+    shortest: f64,
+    reach: f64,
+    start: Instant,
+) -> Result<Tangent, String> {
+    let n2 = second_order::<M>();
+    let n = cube.sim.particles.n_owned;
+    let colours = colour(&cube.sim.particles.x0[..n], reach);
+    let neighbours = Neighbours::new(&cube.sim.particles.x0[..n], reach);
+    let saved_alter = cube.sim.particles.alter.clone();
+    let saved_broken = cube.sim.bonds.broken.clone();
+    let broken = saved_broken.iter().filter(|&&b| b).count();
+    let saved_history = cube.sim.bonds.history.clone();
+    let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
+    let mut plus = vec![0.0; n * n2];
+    let mut rows = Vec::new();
+    let mut evaluations = 0u64;
+    let owned = |p: &Particles<M>, out: &mut Vec<f64>| {
+        for (i, f) in p.force[..n].iter().enumerate() {
+            out[i * n2..(i + 1) * n2].copy_from_slice(&f.as_slice()[..n2]);
+        }
+    };
+    let mut minus = vec![0.0; n * n2];
+    for members in &colours {
+        for k in 0..n2 {
+            let h = if k < 3 {
+                PERTURBATION * shortest
+            } else {
+                PERTURBATION
+            };
+            let free_members: Vec<usize> = members
+                .iter()
+                .copied()
+                .filter(|&i| index[i * n2 + k] != usize::MAX)
+                .collect();
+            if free_members.is_empty() {
+                continue;
+            }
+            for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
+                let sim = &mut cube.sim;
                 for &i in &free_members {
-                    let col = index[i * n2 + k];
-                    neighbours.within(i, &mut rows);
-                    for &j in &rows {
-                        for l in 0..n2 {
-                            let row = index[j * n2 + l];
-                            if row == usize::MAX || row < col {
-                                continue; // the lower triangle is what Cholesky reads
-                            }
-                            // K = −∂F/∂u.
-                            let v = -(plus[j * n2 + l] - minus[j * n2 + l]) / (2.0 * h);
-                            if v != 0.0 {
-                                triplets.push(Triplet::new(row, col, v));
-                            }
+                    sim.particles.alter[i] = saved_alter[i];
+                    nudge(&sim.model, &mut sim.particles.alter[i], k, sign * h);
+                }
+                sim.compute_forces_with(&mut cube.wall);
+                evaluations += 1;
+                owned(&sim.particles, out);
+                for &i in &free_members {
+                    sim.particles.alter[i] = saved_alter[i];
+                }
+            }
+            for &i in &free_members {
+                let col = index[i * n2 + k];
+                neighbours.within(i, &mut rows);
+                for &j in &rows {
+                    for l in 0..n2 {
+                        let row = index[j * n2 + l];
+                        if row == usize::MAX || row < col {
+                            continue; // the lower triangle is what Cholesky reads
+                        }
+                        // K = −∂F/∂u.
+                        let v = -(plus[j * n2 + l] - minus[j * n2 + l]) / (2.0 * h);
+                        if v != 0.0 {
+                            triplets.push(Triplet::new(row, col, v));
                         }
                     }
                 }
             }
         }
-        self.sim.particles.alter = saved_alter;
-        self.sim.bonds.broken = saved_broken;
-        self.sim.bonds.history = saved_history;
-        self.compute_forces();
-        factor(
-            triplets,
-            index,
-            free,
-            broken,
-            evaluations,
-            colours.len(),
-            start,
-        )
+    }
+    cube.sim.particles.alter = saved_alter;
+    cube.sim.bonds.broken = saved_broken;
+    cube.sim.bonds.history = saved_history;
+    cube.compute_forces();
+    factor(
+        triplets,
+        index,
+        free,
+        broken,
+        evaluations,
+        colours.len(),
+        start,
+    )
+}
+
+/// Newton's method with the assembled tangent stiffness, on one procCube; the tangent is kept
+/// between load steps and rebuilt when an iteration does not halve the residual.
+pub struct Newton {
+    pub tolerance: f64,
+    pub max_iterations: u64,
+    /// `[time] stop_at_broken_bonds` (0 = off): the iterations end there.
+    pub stop_at_broken: u64,
+    tangent: Option<Tangent>,
+}
+
+impl Newton {
+    pub fn new(tolerance: f64, max_iterations: u64, stop_at_broken: u64) -> Self {
+        Newton {
+            tolerance,
+            max_iterations,
+            stop_at_broken,
+            tangent: None,
+        }
+    }
+
+    /// The tangent the last load step factored, if it needed one.
+    pub fn tangent(&self) -> Option<&Tangent> {
+        self.tangent.as_ref()
     }
 
     /// One load step of the implicit solve: supports and loads move to `sim.time + sim.dt`,
     /// then Newton iterations with the (re)assembled tangent until the residual force is below
-    /// `tolerance` × (applied forces and reactions), as relaxation measures it. With
-    /// `stop_broken` > 0 the iterations end, unconverged, once that many bonds have broken:
+    /// the tolerance × (applied forces and reactions), as relaxation measures it. With
+    /// `stop_at_broken` > 0 the iterations end, unconverged, once that many bonds have broken:
     /// the run ends there (`[time] stop_at_broken_bonds`), so a new tangent would be wasted.
-    pub fn implicit_step(
-        &mut self,
-        tangent: &mut Option<Tangent>,
-        tolerance: f64,
-        max_iterations: u64,
-        stop_broken: u64,
-    ) -> Result<Relaxed, String> {
+    pub fn load_step<M: Model>(&mut self, cube: &mut Cube<M>) -> Result<Relaxed, String> {
+        let (tolerance, max_iterations, stop_broken) =
+            (self.tolerance, self.max_iterations, self.stop_at_broken);
+        let tangent = &mut self.tangent;
         let n2 = second_order::<M>();
-        let n = self.sim.particles.n_owned;
-        self.begin_load_step();
+        let n = cube.sim.particles.n_owned;
+        begin_load_step(cube);
 
         let mut evaluations = 0u64;
         let mut newton = 0u64;
         let mut residual;
         let mut previous = f64::INFINITY;
         loop {
-            self.compute_forces();
+            cube.compute_forces();
             evaluations += 1;
             let t = Instant::now();
-            let p = &self.sim.particles;
+            let p = &cube.sim.particles;
             let mut sums = vec![0.0];
             for f in &p.force[..n] {
                 sums[0] += f.as_slice()[..n2].iter().map(|v| v * v).sum::<f64>();
             }
-            for l in &self.sim.loads {
-                sums.extend_from_slice(&l.total(self.sim.time));
+            for l in &cube.sim.loads {
+                sums.extend_from_slice(&l.total(cube.sim.time));
             }
-            for c in &self.sim.constraints {
+            for c in &cube.sim.constraints {
                 sums.extend_from_slice(&c.reaction);
             }
-            self.team().reduce(&mut sums, Reduce::Sum);
+            cube.team().reduce(&mut sums, Reduce::Sum);
             let scale = sums[1..].iter().map(|x| x * x).sum::<f64>().sqrt();
             residual = sums[0].sqrt() / scale.max(f64::MIN_POSITIVE);
-            self.sim.timing.lap(Phase::Integration, t);
+            cube.sim.timing.lap(Phase::Integration, t);
             if residual <= tolerance
                 || newton >= max_iterations
-                || (stop_broken > 0 && self.broken_count() as u64 >= stop_broken)
+                || (stop_broken > 0 && cube.broken_count() as u64 >= stop_broken)
             {
                 break;
             }
@@ -514,14 +536,14 @@ impl<M: Model> Cube<M> {
             // spend nearly all its time assembling.
             let slow = newton > 0 && residual > 0.5 * last_residual;
             if slow || tangent.is_none() {
-                let k = self.assemble_tangent()?;
+                let k = assemble_tangent(cube)?;
                 evaluations += k.evaluations;
                 *tangent = Some(k);
             }
             let t = Instant::now();
             let k = tangent.as_ref().expect("assembled above");
             let mut rhs = faer::Mat::<f64>::zeros(k.free, 1);
-            let p = &self.sim.particles;
+            let p = &cube.sim.particles;
             for (i, f) in p.force[..n].iter().enumerate() {
                 for (l, &f) in f.as_slice()[..n2].iter().enumerate() {
                     let r = k.index[i * n2 + l];
@@ -535,7 +557,7 @@ impl<M: Model> Cube<M> {
                 Factor::Lu(f) => f.solve_in_place(rhs.as_mut()),
             }
             // u += K⁻¹F, through the model's drift (rotations compose).
-            let sim = &mut self.sim;
+            let sim = &mut cube.sim;
             for i in 0..n {
                 let a = sim.particles.alter[i].as_mut_slice();
                 for l in 0..n2 {
@@ -544,7 +566,7 @@ impl<M: Model> Cube<M> {
                 }
                 sim.model.drift(&mut sim.particles.alter[i], 1.0);
             }
-            crate::solve::adr::zero_velocities(&mut sim.particles);
+            zero_velocities(&mut sim.particles);
             newton += 1;
             sim.timing.lap(Phase::Integration, t);
         }
@@ -553,6 +575,14 @@ impl<M: Model> Cube<M> {
             residual,
             converged: residual <= tolerance,
             diverged: false,
+        })
+    }
+}
+
+impl<M: Model> Solver<M> for Newton {
+    fn advance(&mut self, cube: &mut Cube<M>, _step: u64) -> Result<Option<Relaxed>, String> {
+        self.load_step(cube).map(Some).map_err(|e| {
+            format!("{e} (or use [solver] kind = \"adr\", which assembles no tangent)")
         })
     }
 }

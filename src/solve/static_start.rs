@@ -14,6 +14,7 @@ use crate::input::setup::Setup;
 use crate::model::Model;
 use crate::parallel::decomposition::{cell_plans, Layout, Walls};
 use crate::parallel::snapshot::Snapshot;
+use crate::solve::Newton;
 use std::time::Instant;
 
 /// Residual of the static solve, relative to the applied forces and reactions (the implicit
@@ -67,9 +68,9 @@ pub fn solve<M: Model>(setup: &Setup<M>, until: f64, walls: Walls) -> Result<Sta
     cube.start();
     // One load step from 0 to `until`.
     cube.sim.dt = until;
-    let mut tangent = None;
-    let r = cube
-        .implicit_step(&mut tangent, TOLERANCE, MAX_ITERATIONS, 0)
+    let mut newton = Newton::new(TOLERANCE, MAX_ITERATIONS, 0);
+    let r = newton
+        .load_step(&mut cube)
         .map_err(|e| format!("[time] static_until: {e} (or leave static_until out)"))?;
     if !r.converged {
         return Err(format!(
@@ -80,8 +81,8 @@ pub fn solve<M: Model>(setup: &Setup<M>, until: f64, walls: Walls) -> Result<Sta
     }
     let broken = cube.broken_count();
     // No tangent when the start state is already in equilibrium (no load yet at `until`).
-    let (method, nonzeros) = tangent
-        .as_ref()
+    let (method, nonzeros) = newton
+        .tangent()
         .map_or(("not needed", 0), |k| (k.method, k.nonzeros));
     cube.sim.dt = setup.sim.dt;
     cube.sim.step = 0;
