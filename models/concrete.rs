@@ -13,7 +13,7 @@
 
 use crate::model::{
     bond_based_lame, check_options, stretch, BondGeom, Dimension, Material, MaterialKind, Model,
-    ModelBuild, ModelError, PairTable, Side,
+    ModelBuild, ModelError, PairTable, Sample, SampleOf, Side,
 };
 use std::f64::consts::PI;
 
@@ -119,6 +119,38 @@ impl Model for Concrete {
             delta: b.horizon,
             density: b.materials.iter().map(|m| m.density).collect(),
         })
+    }
+
+    fn sample(of: &SampleOf) -> Option<Sample> {
+        Some(Sample::new(match *of {
+            // The benchmark's stiffness through the thesis's E′ = 6E/(πδ⁴(1−2ν)) at ν = 0.25,
+            // its critical stretch in tension and 10x in compression.
+            SampleOf::Benchmark {
+                micromodulus,
+                horizon,
+                critical_stretch: s0,
+                density,
+            } => {
+                let e = micromodulus * PI * horizon.powf(4.0) * 0.5 / 6.0;
+                format!("kind = \"concrete\"\ndensity = {density}\nyoungs_modulus = {e:e}\npoisson_ratio = 0.25\ntensile_stretch = {s0}\ncompressive_stretch = {}\n", -10.0 * s0)
+            }
+            // Steel that never yields: the stiffness contrast of a reinforced section.
+            SampleOf::Solid {
+                youngs_modulus: e,
+                density,
+                steel: true,
+                ..
+            } => format!("kind = \"steel\"\ndensity = {density}\nyoungs_modulus = {e:e}\npoisson_ratio = 0.25\nyield_stretch = 1e6\n"),
+            SampleOf::Solid {
+                youngs_modulus: e,
+                density,
+                critical_stretch: s0,
+                ..
+            } => {
+                let (t, c) = if s0.is_finite() { (s0, -10.0 * s0) } else { (1e6, -1e6) };
+                format!("kind = \"concrete\"\ndensity = {density}\nyoungs_modulus = {e:e}\npoisson_ratio = 0.25\ntensile_stretch = {t:e}\ncompressive_stretch = {c:e}\n")
+            }
+        }))
     }
 
     fn breaks(&self) -> bool {

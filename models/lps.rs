@@ -17,7 +17,8 @@
 //! (ω = exp(−L²/(0.4δ)²)).
 
 use crate::model::{
-    check_options, BondGeom, Dimension, Material, Model, ModelBuild, ModelError, Side,
+    check_options, stretch_line, BondGeom, Dimension, Material, Model, ModelBuild, ModelError,
+    Sample, SampleOf, Side,
 };
 
 pub use super::pmb::{Force3, Motion};
@@ -117,6 +118,7 @@ impl Model for Lps {
         "influence function: \"one\" (default), \"inverse_length\" (delta/L) or \"gaussian\"",
     )];
     const FIXED_FROM_BONDS: bool = true;
+    const LAMMPS_PEER: Option<&'static str> = Some("peri/lps");
 
     type Alter = Motion;
     type Fixed = WeightedVolume;
@@ -141,6 +143,30 @@ impl Model for Lps {
             density: b.materials.iter().map(|m| m.density).collect(),
             delta,
             influence,
+        })
+    }
+
+    fn sample(of: &SampleOf) -> Option<Sample> {
+        Some(match *of {
+            // LAMMPS `peri/lps`'s own constants (K = G = 14.9 GPa, so ν = 1/8) and influence
+            // function ω = δ/L, so that the peer runs the same scene.
+            SampleOf::Benchmark {
+                critical_stretch,
+                density,
+                ..
+            } => Sample::new(format!(
+                "density = {density}\nbulk_modulus = 14.9e9\npoisson_ratio = 0.125\ncritical_stretch = {critical_stretch}\n"
+            ))
+            .with_options("influence = \"inverse_length\"\n"),
+            SampleOf::Solid {
+                youngs_modulus,
+                density,
+                critical_stretch,
+                ..
+            } => Sample::new(format!(
+                "density = {density}\nyoungs_modulus = {youngs_modulus:e}\npoisson_ratio = 0.25\n{}",
+                stretch_line("critical_stretch", critical_stretch)
+            )),
         })
     }
 

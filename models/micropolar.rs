@@ -27,7 +27,8 @@ use crate::model::attributes::Attributes;
 use crate::model::lanes::{LaneForces, Real, F4, LANES};
 use crate::model::rotation::{matrix, product, quaternion, relative, rotation_vector};
 use crate::model::{
-    check_options, BondGeom, Dimension, Material, MaterialKind, Model, ModelBuild, ModelError, Side,
+    check_options, stretch_line, BondGeom, Dimension, Material, MaterialKind, Model, ModelBuild,
+    ModelError, Sample, SampleOf, Side,
 };
 use std::f64::consts::PI;
 
@@ -262,6 +263,44 @@ impl Model for Micropolar {
             kappa,
             delta,
             spacing: b.spacing,
+        })
+    }
+
+    fn sample(of: &SampleOf) -> Option<Sample> {
+        Some(match *of {
+            // The benchmark's bulk modulus at ν = 0.2, so that the shear part (c_s > 0) and its
+            // moments are computed; rotations bound the step below the other models' 1e-7 s
+            // (docs/theory.md §4).
+            SampleOf::Benchmark {
+                micromodulus,
+                horizon,
+                critical_stretch,
+                density,
+            } => {
+                let k = micromodulus * PI * horizon.powf(4.0) / 18.0;
+                Sample::new(format!(
+                    "density = {density}\nyoungs_modulus = {:e}\npoisson_ratio = 0.2\ncritical_stretch = {critical_stretch}\n",
+                    3.0 * k * (1.0 - 0.4)
+                ))
+                .with_dt(5e-8)
+            }
+            SampleOf::Solid {
+                youngs_modulus,
+                density,
+                critical_stretch,
+                full,
+                ..
+            } => {
+                let sample = Sample::new(format!(
+                    "density = {density}\nyoungs_modulus = {youngs_modulus:e}\npoisson_ratio = 0.2\n{}",
+                    stretch_line("critical_stretch", critical_stretch)
+                ));
+                if full {
+                    sample.with_options("kappa = 0.05\n")
+                } else {
+                    sample
+                }
+            }
         })
     }
 

@@ -6,8 +6,8 @@
 //! and the smaller critical stretch.
 
 use crate::model::{
-    bond_based_lame, check_options, stretch, BondGeom, Dimension, Material, Model, ModelBuild,
-    ModelError, PairTable, Side,
+    bond_based_lame, check_options, stretch, stretch_line, BondGeom, Dimension, Material, Model,
+    ModelBuild, ModelError, PairTable, Sample, SampleOf, Side,
 };
 use std::f64::consts::PI;
 
@@ -95,6 +95,7 @@ impl Model for Pmb {
     const NAME: &'static str = "pmb";
     const SUMMARY: &'static str =
         "bond-based prototype microelastic brittle solid (Silling), nu = 1/4, critical stretch";
+    const LAMMPS_PEER: Option<&'static str> = Some("peri/pmb");
 
     type Alter = Motion;
     type Fixed = ();
@@ -116,6 +117,28 @@ impl Model for Pmb {
             delta: b.horizon,
             density: b.materials.iter().map(|m| m.density).collect(),
         })
+    }
+
+    fn sample(of: &SampleOf) -> Option<Sample> {
+        Some(Sample::new(match *of {
+            SampleOf::Benchmark {
+                micromodulus,
+                critical_stretch,
+                density,
+                ..
+            } => format!(
+                "density = {density}\nmicromodulus = {micromodulus:e}\ncritical_stretch = {critical_stretch}\n"
+            ),
+            SampleOf::Solid {
+                youngs_modulus,
+                density,
+                critical_stretch,
+                ..
+            } => format!(
+                "density = {density}\nyoungs_modulus = {youngs_modulus:e}\n{}",
+                stretch_line("critical_stretch", critical_stretch)
+            ),
+        }))
     }
 
     fn breaks(&self) -> bool {

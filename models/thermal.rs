@@ -14,8 +14,8 @@
 //! * A broken bond carries neither force nor heat: a crack insulates.
 
 use crate::model::{
-    bond_based_lame, check_options, BondGeom, Dimension, Material, Model, ModelBuild, ModelError,
-    Side,
+    bond_based_lame, check_options, stretch_line, BondGeom, Dimension, Material, Model, ModelBuild,
+    ModelError, Sample, SampleOf, Side,
 };
 use std::f64::consts::PI;
 
@@ -96,6 +96,48 @@ impl Model for Thermal {
             specific_heat,
             reference,
             delta,
+        })
+    }
+
+    fn sample(of: &SampleOf) -> Option<Sample> {
+        // Concrete-like conduction: k = 2 W/m/K, c_p = 900 J/kg/K.
+        let heat = "thermal_conductivity = 2.0\nspecific_heat = 900.0\n";
+        Some(match *of {
+            SampleOf::Benchmark {
+                micromodulus,
+                horizon,
+                critical_stretch,
+                density,
+            } => {
+                let k = micromodulus * PI * horizon.powf(4.0) / 18.0;
+                Sample::new(format!(
+                    "density = {density}\nbulk_modulus = {k:e}\ncritical_stretch = {critical_stretch}\n{heat}thermal_expansion = 1e-5\n"
+                ))
+            }
+            // Without expansion (not `full`) the mechanics are PMB's and the mechanical energy
+            // is conserved on its own.
+            SampleOf::Solid {
+                youngs_modulus,
+                density,
+                critical_stretch,
+                full,
+                ..
+            } => {
+                let expansion = if full {
+                    "thermal_expansion = 1e-5\n"
+                } else {
+                    ""
+                };
+                let sample = Sample::new(format!(
+                    "density = {density}\nyoungs_modulus = {youngs_modulus:e}\n{heat}{expansion}{}",
+                    stretch_line("critical_stretch", critical_stretch)
+                ));
+                if full {
+                    sample
+                } else {
+                    sample.mechanics_of(super::pmb::Pmb::NAME)
+                }
+            }
         })
     }
 

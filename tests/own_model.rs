@@ -13,7 +13,7 @@ use pdq::driver::run::{run_model, RunOptions};
 use pdq::input::deck;
 use pdq::model::{
     bond_based_lame, check_options, stretch, BondGeom, Dimension, Material, Model, ModelBuild,
-    ModelError, PairTable, Side,
+    ModelError, ModelInfo, PairTable, Sample, SampleOf, Side,
 };
 use pdq::models::pmb::{Force3, Motion};
 use std::f64::consts::PI;
@@ -79,6 +79,34 @@ impl Model for Softening {
             density: b.materials.iter().map(|m| m.density).collect(),
             delta: b.horizon,
         })
+    }
+
+    /// Its sample for the lab's scenes: the same stiffness, bonds softening from s0 to 8 s0.
+    /// It has no unbreakable sample (it needs both stretches).
+    fn sample(of: &SampleOf) -> Option<Sample> {
+        let (e, density, s0) = match *of {
+            SampleOf::Benchmark {
+                micromodulus,
+                horizon,
+                critical_stretch,
+                density,
+            } => (
+                micromodulus * PI * horizon.powf(4.0) / 12.0,
+                density,
+                critical_stretch,
+            ),
+            SampleOf::Solid {
+                youngs_modulus,
+                density,
+                critical_stretch,
+                ..
+            } if critical_stretch.is_finite() => (youngs_modulus, density, critical_stretch),
+            SampleOf::Solid { .. } => return None,
+        };
+        Some(Sample::new(format!(
+            "density = {density}\nyoungs_modulus = {e:e}\ncritical_stretch = {s0:e}\nsoftening_stretch = {:e}\n",
+            8.0 * s0
+        )))
     }
 
     fn inertia(&self, material: u16, volume: f64, _: &()) -> Force3 {
@@ -250,4 +278,14 @@ fn own_parameter_errors_name_the_key_and_its_line() {
     let units = ROCK.replace("\"20 GPa\"", "\"20 mm\"");
     let err = run(&pull_deck(&units, 0.002), "units").unwrap_err();
     assert!(err.contains("stress") && err.contains("length"), "{err}");
+}
+
+/// Its own sample material puts it on the benchmark's scene, as a registered model's does.
+#[test]
+fn own_sample_makes_the_benchmark_scene() {
+    let text = pdq::lab::bench::standard_deck_of(&ModelInfo::of::<Softening>(), 6, 20).unwrap();
+    assert!(text.contains("name = \"softening\"") && text.contains("softening_stretch = 4e-3"));
+    let s = run(&text, "bench").unwrap();
+    assert_eq!(s.steps, 20);
+    assert!(s.bonds > 0);
 }

@@ -6,7 +6,7 @@
 
 use crate::input::deck;
 use crate::input::setup;
-use crate::model::{Model, ModelVisitor};
+use crate::model::{Model, ModelInfo, ModelVisitor, SampleOf};
 use crate::parallel;
 use crate::parallel::decomposition::{Procs, Walls};
 use std::fmt::Write as _;
@@ -50,42 +50,64 @@ pub struct BenchOptions {
 
 const SPACING: f64 = 0.001;
 
-/// The standard scene as a deck, for `model` (every model in `models/`): the same block, the
-/// same stiffness (K of the PMB micromodulus) and critical stretch, and for LPS the peer's
-/// moduli and influence function (LAMMPS `peri/lps`: K = G = 14.9 GPa, ω = 1/r).
+/// The benchmark's solid, which each model writes in its own keys ([`SampleOf::Benchmark`]):
+/// the stiffness of the PMB micromodulus of LAMMPS `peri/pmb` and its critical stretch.
+pub const BENCHMARK: SampleOf = SampleOf::Benchmark {
+    micromodulus: 1.6863e22,
+    horizon: 0.003015,
+    critical_stretch: 0.0005,
+    density: 2200.0,
+};
+
+/// The models with a benchmark solid: the registry's, in its order (`--model all`).
+pub fn bench_models() -> Vec<ModelInfo> {
+    crate::models::info()
+        .into_iter()
+        .filter(|m| m.sample(&BENCHMARK).is_some())
+        .collect()
+}
+
+/// The standard scene as a deck, for the registered model called `model`.
 pub fn standard_deck(model: &str, n: usize, steps: u64) -> Result<String, String> {
-    let h = SPACING;
-    let hi = (n as f64 + 0.5) * h;
-    let material = match model {
-        "pmb" => {
-            "density = 2200\nmicromodulus = 1.6863e22\ncritical_stretch = 0.0005\n".to_string()
-        }
-        // The same stiffness through the thesis's E′ = 6E/(πδ⁴(1−2ν)) at ν = 0.25, with the
-        // benchmark's critical stretch in tension and 10x in compression.
-        "concrete" => {
-            let e = 1.6863e22 * std::f64::consts::PI * 0.003015f64.powi(4) * 0.5 / 6.0;
-            format!("kind = \"concrete\"\ndensity = 2200\nyoungs_modulus = {e:e}\npoisson_ratio = 0.25\ntensile_stretch = 0.0005\ncompressive_stretch = -0.005\n")
-        }
-        "lps" => "density = 2200\nbulk_modulus = 14.9e9\npoisson_ratio = 0.125\ncritical_stretch = 0.0005\n[model.options]\ninfluence = \"inverse_length\"\n".to_string(),
-        // ν = 0.2 so that the shear part (c_s > 0) and its moments are computed.
-        "micropolar" => {
-            let k = 1.6863e22 * std::f64::consts::PI * 0.003015f64.powi(4) / 18.0;
-            format!("density = 2200\nyoungs_modulus = {:e}\npoisson_ratio = 0.2\ncritical_stretch = 0.0005\n", 3.0 * k * (1.0 - 0.4))
-        }
-        "thermal" => {
-            let k = 1.6863e22 * std::f64::consts::PI * 0.003015f64.powi(4) / 18.0;
-            format!("density = 2200\nbulk_modulus = {k:e}\ncritical_stretch = 0.0005\nthermal_conductivity = 2.0\nspecific_heat = 900.0\nthermal_expansion = 1e-5\n")
-        }
-        other => {
-            return Err(format!(
-                "no standard bench scene for model '{other}' (use pmb, concrete, lps, micropolar or thermal)"
+    match crate::models::find(model) {
+        Some(info) if info.sample(&BENCHMARK).is_some() => standard_deck_of(&info, n, steps),
+        _ => {
+            let names: Vec<&str> = bench_models().iter().map(|m| m.name).collect();
+            Err(format!(
+                "no standard bench scene for model '{model}' (use {})",
+                or_list(&names)
             ))
         }
-    };
+    }
+}
+
+/// "a, b or c".
+fn or_list(names: &[&str]) -> String {
+    match names {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [rest @ .., last] => format!("{} or {last}", rest.join(", ")),
+    }
+}
+
+/// The standard scene as a deck, for any model with a benchmark solid (a registered one, or
+/// one run through `run_model`): the same block, the model's own sample of the benchmark's
+/// solid, and its own Δt where it needs a shorter one than the peer's 1e-7 s.
+pub fn standard_deck_of(model: &ModelInfo, n: usize, steps: u64) -> Result<String, String> {
+    let sample = model.sample(&BENCHMARK).ok_or_else(|| {
+        format!(
+            "model '{}' has no sample of the benchmark's solid",
+            model.name
+        )
+    })?;
+    let h = SPACING;
+    let hi = (n as f64 + 0.5) * h;
+    let (model, material) = (model.name, sample.material);
     // Model options come after the material table in TOML, so they close the deck's [model].
-    let (material, options) = match material.split_once("[model.options]") {
-        Some((m, o)) => (m.to_string(), format!("[model.options]{o}")),
-        None => (material, String::new()),
+    let options = if sample.options.is_empty() {
+        String::new()
+    } else {
+        format!("[model.options]\n{}", sample.options)
     };
     Ok(format!(
         r#"title = "standard benchmark scene ({model})"
@@ -117,8 +139,7 @@ history_every = {steps}
 "#,
         o = -0.5 * h,
         top = (n as f64 - 2.5) * h,
-        // Rotations bound micropolar's step below the peer's 1e-7 s (docs/theory.md §4).
-        dt = if model == "micropolar" { 5e-8 } else { 1e-7 },
+        dt = sample.dt.unwrap_or(1e-7),
     ))
 }
 
@@ -127,8 +148,8 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Runs the benchmark and returns the lines it printed. `--model all` runs every model (the
-/// LAMMPS peer for PMB and LPS, which it has) and ends with a Markdown table.
+/// Runs the benchmark and returns the lines it printed. `--model all` runs every model with a
+/// benchmark solid (the LAMMPS peer for those that have one) and ends with a Markdown table.
 pub fn run(opts: &BenchOptions) -> Result<String, String> {
     if opts.threads.contains(&0) || opts.ranks.contains(&0) {
         return Err("threads and ranks must be at least 1".into());
@@ -138,11 +159,11 @@ pub fn run(opts: &BenchOptions) -> Result<String, String> {
     }
     if opts.model == "all" {
         let mut out = String::new();
-        for model in ALL_MODELS {
+        for model in bench_models() {
             let one = BenchOptions {
-                model: model.into(),
-                peer: opts.peer && (model == "pmb" || model == "lps"),
-                yardstick: opts.yardstick && model == "pmb",
+                model: model.name.into(),
+                peer: opts.peer && model.lammps_peer.is_some(),
+                yardstick: opts.yardstick && model.name == yardstick::MODEL,
                 ..opts.clone()
             };
             out.push_str(&run(&one)?);
@@ -183,7 +204,7 @@ fn run_one(opts: &BenchOptions) -> Result<String, String> {
                     if t == 1 {
                         let _ = writeln!(
                             out,
-                            "bench ratio lammps/pdq={:.2} (model={} vs peri/{}, 1 core each)",
+                            "bench ratio lammps/pdq={:.2} (model={} vs {}, 1 core each)",
                             theirs / ours,
                             opts.model,
                             peer_style(&opts.model)
@@ -222,9 +243,6 @@ fn line<M: Model>(
         crate::engine::bonds::BondList::<M::Bond>::bytes_per_bond(),
     )
 }
-
-/// The models `--model all` runs, in table order.
-pub const ALL_MODELS: [&str; 5] = ["pmb", "concrete", "lps", "micropolar", "thermal"];
 
 /// `key=value` of a standard line.
 fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {

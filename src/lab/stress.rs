@@ -16,7 +16,7 @@ use crate::engine::spectrum::LANCZOS_STEPS;
 use crate::input::deck;
 use crate::input::setup::{self, Setup};
 use crate::model::attributes::Attributes;
-use crate::model::{second_order, Model, ModelVisitor};
+use crate::model::{second_order, Model, ModelVisitor, Sample, SampleOf};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -35,8 +35,17 @@ pub struct StressOptions {
     pub threads: usize,
 }
 
-/// The models stressed, in table order.
-pub const MODELS: [&str; 5] = ["pmb", "concrete", "lps", "micropolar", "thermal"];
+/// The models stressed, in table order: the registry's with a sample solid.
+pub fn models() -> Vec<&'static str> {
+    crate::models::info()
+        .into_iter()
+        .filter(|m| {
+            m.sample(&solid(CONCRETE_E, 2400.0, FAILURE_S0, false))
+                .is_some()
+        })
+        .map(|m| m.name)
+        .collect()
+}
 
 /// The lattices of the critical-time-step table.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,65 +71,43 @@ const SPACING: f64 = 1e-3;
 const CONCRETE_E: f64 = 25e9;
 const STEEL_E: f64 = 200e9;
 
-/// One material table of `model`, stiffness `e`, density `rho`, critical stretch `s0` (∞:
-/// unbreakable), `steel` for the concrete model's steel kind.
-fn material(model: &str, e: f64, rho: f64, s0: f64, steel: bool) -> String {
-    let breaks = s0.is_finite();
-    let s = |key: &str| {
-        if breaks {
-            format!("{key} = {s0:e}\n")
-        } else {
-            String::new()
-        }
-    };
-    match model {
-        "pmb" => format!("density = {rho}\nyoungs_modulus = {e:e}\n{}", s("critical_stretch")),
-        "concrete" if steel => format!(
-            "kind = \"steel\"\ndensity = {rho}\nyoungs_modulus = {e:e}\npoisson_ratio = 0.25\nyield_stretch = 1e6\n"
-        ),
-        "concrete" => {
-            let (t, c) = if breaks { (s0, -10.0 * s0) } else { (1e6, -1e6) };
-            format!("kind = \"concrete\"\ndensity = {rho}\nyoungs_modulus = {e:e}\npoisson_ratio = 0.25\ntensile_stretch = {t:e}\ncompressive_stretch = {c:e}\n")
-        }
-        "lps" => format!(
-            "density = {rho}\nyoungs_modulus = {e:e}\npoisson_ratio = 0.25\n{}",
-            s("critical_stretch")
-        ),
-        "micropolar" => format!(
-            "density = {rho}\nyoungs_modulus = {e:e}\npoisson_ratio = 0.2\n{}",
-            s("critical_stretch")
-        ),
-        // Concrete-like conduction: k = 2 W/m/K, c_p = 900 J/kg/K; no expansion, so the
-        // mechanical energy is conserved on its own.
-        "thermal" => format!(
-            "density = {rho}\nyoungs_modulus = {e:e}\nthermal_conductivity = 2.0\nspecific_heat = 900.0\n{}",
-            s("critical_stretch")
-        ),
-        _ => unreachable!("unknown stress model {model}"),
+/// The plain solid of stiffness `e`, density `rho`, critical stretch `s0` (∞: unbreakable),
+/// `steel` for the steel of a steel–concrete lattice.
+fn solid(e: f64, rho: f64, s0: f64, steel: bool) -> SampleOf {
+    SampleOf::Solid {
+        youngs_modulus: e,
+        density: rho,
+        critical_stretch: s0,
+        steel,
+        full: false,
     }
 }
 
+/// The sample material of the registered model called `model` for `of`.
+fn sample(model: &str, of: &SampleOf) -> Result<Sample, String> {
+    crate::models::find(model)
+        .and_then(|m| m.sample(of))
+        .ok_or_else(|| format!("pdq stress: model '{model}' has no sample material"))
+}
+
 /// A block of nx × ny × nz lattice sites, m = 3.
-fn block_deck(model: &str, n: [usize; 3], lattice: Lattice, s0: f64) -> String {
+fn block_deck(model: &str, n: [usize; 3], lattice: Lattice, s0: f64) -> Result<String, String> {
     let h = SPACING;
     let hi = n.map(|k| k as f64 * h);
-    let mut t = format!(
-        "title = \"stress {model}\"\nunits = \"SI\"\n[model]\nname = \"{model}\"\nm = 3\n[lattice]\nspacing = {h:e}\n"
-    );
+    let concrete = sample(model, &solid(CONCRETE_E, 2400.0, s0, false))?;
+    let mut t =
+        format!("title = \"stress {model}\"\nunits = \"SI\"\n[model]\nname = \"{model}\"\nm = 3\n");
+    if !concrete.options.is_empty() {
+        let _ = write!(t, "[model.options]\n{}", concrete.options);
+    }
+    let _ = write!(t, "[lattice]\nspacing = {h:e}\n");
     if lattice == Lattice::Jittered {
         t.push_str("jitter = 0.2\nseed = 7\n");
     }
-    let _ = write!(
-        t,
-        "[materials.concrete]\n{}",
-        material(model, CONCRETE_E, 2400.0, s0, false)
-    );
+    let _ = write!(t, "[materials.concrete]\n{}", concrete.material);
     if lattice == Lattice::SteelConcrete {
-        let _ = write!(
-            t,
-            "[materials.steel]\n{}",
-            material(model, STEEL_E, 7850.0, s0, true)
-        );
+        let steel = sample(model, &solid(STEEL_E, 7850.0, s0, true))?;
+        let _ = write!(t, "[materials.steel]\n{}", steel.material);
     }
     let _ = write!(
         t,
@@ -143,7 +130,7 @@ fn block_deck(model: &str, n: [usize; 3], lattice: Lattice, s0: f64) -> String {
         }
     }
     t.push_str("[time]\nsteps = 1\nsafety_factor = 0.8\n[output]\nprogress = false\n");
-    t
+    Ok(t)
 }
 
 /// Uniform in [−1, 1), a function of (i, k) only.
@@ -295,7 +282,7 @@ pub fn critical_step(
     steps: u64,
     halvings: usize,
 ) -> Result<CriticalStep, String> {
-    let text = block_deck(model, [n; 3], lattice, f64::INFINITY);
+    let text = block_deck(model, [n; 3], lattice, f64::INFINITY)?;
     let scene = deck::parse(&text, "<stress>", "stress").map_err(|e| e.to_string())?;
     let started = Instant::now();
     let (particles, bound, lo, hi, measured) = setup::with_model(
@@ -384,7 +371,7 @@ pub struct Drift {
 /// An elastic vibration of a free block: a stretching mode along x plus 10 % random
 /// velocities, unbreakable bonds, the deck's default safety factor.
 pub fn drift(model: &str, n: usize, steps: u64, measured: bool) -> Result<Drift, String> {
-    let mut text = block_deck(model, [n; 3], Lattice::Regular, f64::INFINITY);
+    let mut text = block_deck(model, [n; 3], Lattice::Regular, f64::INFINITY)?;
     if measured {
         text = text.replace(
             "safety_factor = 0.8\n",
@@ -498,7 +485,7 @@ pub fn failure(model: &str, case: Failure, steps: u64) -> Result<FailureRun, Str
         Failure::Impact(_) => [16, 16, 12],
         _ => [20, 8, 8],
     };
-    let text = block_deck(model, n, Lattice::Regular, FAILURE_S0);
+    let text = block_deck(model, n, Lattice::Regular, FAILURE_S0)?;
     let scene = deck::parse(&text, "<stress>", "stress").map_err(|e| e.to_string())?;
     struct Visit<'a>(&'a deck::Scene, Failure, u64, [usize; 3]);
     impl ModelVisitor for Visit<'_> {
@@ -590,11 +577,12 @@ pub fn failure(model: &str, case: Failure, steps: u64) -> Result<FailureRun, Str
 
 /// Runs the stress tests and returns the report (Markdown tables).
 pub fn run(opts: &StressOptions) -> Result<String, String> {
+    let all = models();
     for m in &opts.models {
-        if !MODELS.contains(&m.as_str()) {
+        if !all.contains(&m.as_str()) {
             return Err(format!(
                 "pdq stress: unknown model '{m}' (use {})",
-                MODELS.join(", ")
+                all.join(", ")
             ));
         }
     }
@@ -605,9 +593,8 @@ pub fn run(opts: &StressOptions) -> Result<String, String> {
             ));
         }
     }
-    let models: Vec<&str> = MODELS
-        .iter()
-        .copied()
+    let models: Vec<&str> = all
+        .into_iter()
         .filter(|m| opts.models.is_empty() || opts.models.iter().any(|o| o == m))
         .collect();
     let wants = |s: &str| opts.sections.is_empty() || opts.sections.iter().any(|o| o == s);

@@ -8,8 +8,10 @@ pub mod attributes;
 pub mod lanes;
 pub mod material;
 pub mod rotation;
+pub mod sample;
 
 pub use material::{Dimension, Material, MaterialKind, ModelError, PairTable, Units, Written};
+pub use sample::{stretch_line, Sample, SampleOf};
 
 use crate::model::attributes::Attributes;
 use crate::model::lanes::{LaneForces, LANES};
@@ -151,6 +153,9 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     /// models without bond history (`Bond` = `()`) and with at most
     /// [`crate::model::lanes::MAX_COMPONENTS`] generalized forces.
     const BOND_LANES: usize = 1;
+    /// The LAMMPS pair style of the same law (`"peri/pmb"`), which `pdq bench --peer` runs on
+    /// the benchmark scene; `None`: LAMMPS has none.
+    const LAMMPS_PEER: Option<&'static str> = None;
 
     /// Changes during a run: generalized coordinates, then their velocities, then extras.
     type Alter: Attributes;
@@ -168,6 +173,13 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     type Law: Copy + Send + Sync + 'static;
 
     fn build(b: &ModelBuild) -> Result<Self, ModelError>;
+
+    /// A material of this model for a scene written in code (the benchmark, the stress tests'
+    /// blocks, the tests' decks; [`crate::model::sample`]). `None`: it has none, and those
+    /// tools leave the model out.
+    fn sample(_of: &SampleOf) -> Option<Sample> {
+        None
+    }
 
     /// Whether a bond of this scene can break (some critical stretch is finite). When none can,
     /// the engine runs the pair pass without damage bookkeeping: no broken flags read or
@@ -357,6 +369,12 @@ pub struct ModelInfo {
     pub bond: &'static [crate::model::attributes::Field],
     pub state: &'static [crate::model::attributes::Field],
     pub force: &'static [crate::model::attributes::Field],
+    /// [`Model::FIRST_ORDER`]: how many degrees of freedom are rates (temperature).
+    pub first_order: usize,
+    /// [`Model::LAMMPS_PEER`].
+    pub lammps_peer: Option<&'static str>,
+    /// [`Model::sample`].
+    pub sample: fn(&SampleOf) -> Option<Sample>,
 }
 
 impl ModelInfo {
@@ -370,11 +388,20 @@ impl ModelInfo {
             bond: <M::Bond as Attributes>::FIELDS,
             state: <M::State as Attributes>::FIELDS,
             force: <M::Force as Attributes>::FIELDS,
+            first_order: M::FIRST_ORDER,
+            lammps_peer: M::LAMMPS_PEER,
+            sample: M::sample,
         }
+    }
+
+    /// Its sample material for `of`, if it has one.
+    pub fn sample(&self, of: &SampleOf) -> Option<Sample> {
+        (self.sample)(of)
     }
 }
 
-/// Generates the lookup of models by name (`names`, `info`, `visit`) from a list of types.
+/// Generates the lookup of models by name (`names`, `info`, `find`, `visit`) from a list of
+/// types.
 /// Used once, in `models/mod.rs`.
 #[macro_export]
 macro_rules! model_registry {
@@ -387,6 +414,11 @@ macro_rules! model_registry {
         /// Declared data of every model.
         pub fn info() -> Vec<$crate::model::ModelInfo> {
             vec![$($crate::model::ModelInfo::of::<$ty>()),+]
+        }
+
+        /// Declared data of the model called `name`.
+        pub fn find(name: &str) -> Option<$crate::model::ModelInfo> {
+            info().into_iter().find(|m| m.name == name)
         }
 
         /// Builds the model called `name` and hands it to `visitor`.

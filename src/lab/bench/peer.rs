@@ -11,13 +11,12 @@ const LAMMPS_LPS: &str = "units si\nboundary s s s\natom_style peri\natom_modify
 
 const LAMMPS_PMB: &str = "units si\nboundary s s s\natom_style peri\natom_modify map array\nlattice sc 0.001\nregion box block 0 ${n} 0 ${n} 0 ${n}\ncreate_box 1 box\ncreate_atoms 1 region box\npair_style peri/pmb\npair_coeff * * 1.6863e22 0.0030150 0.0005 0.25\nset group all density 2200\nset group all volume 1.0e-9\nvelocity all set 0.0 0.0 0.0 sum no units box\nregion top block INF INF INF INF $(v_n-2) ${n} units lattice\ngroup top region top\nvelocity top set 0.0 0.0 1.0 sum no units box\nneighbor 0.0010 bin\nfix 1 all nve\ntimestep 1.0e-7\nthermo 100\nrun ${steps}\n";
 
-/// The LAMMPS pair style a model is compared with: `peri/lps` for LPS, `peri/pmb` for the rest.
+/// The LAMMPS pair style a model is compared with: its own peer ([`crate::model::Model::LAMMPS_PEER`]),
+/// else `peri/pmb`, whose solid the benchmark's is.
 pub(super) fn peer_style(model: &str) -> &'static str {
-    if model == "lps" {
-        "lps"
-    } else {
-        "pmb"
-    }
+    crate::models::find(model)
+        .and_then(|m| m.lammps_peer)
+        .unwrap_or("peri/pmb")
 }
 
 /// LAMMPS `peri/pmb` (or `peri/lps`) on the same scene: `Ok(Ok((line, µs per particle-step)))`, or
@@ -31,7 +30,7 @@ pub(super) fn peer(
     let dir = std::env::temp_dir().join(format!("pdq-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let style = peer_style(&opts.model);
-    let (name, text) = if style == "lps" {
+    let (name, text) = if style == "peri/lps" {
         ("lammps_lps.in", LAMMPS_LPS)
     } else {
         ("lammps_pmb.in", LAMMPS_PMB)
@@ -58,7 +57,7 @@ pub(super) fn peer(
         Ok(o) => o,
         Err(e) => {
             return Ok(Err(format!(
-                "bench peer=lammps-peri/{style} skipped: cannot run '{lmp}' ({e}); install it with apt-get install lammps\n"
+                "bench peer=lammps-{style} skipped: cannot run '{lmp}' ({e}); install it with apt-get install lammps\n"
             )))
         }
     };
@@ -84,7 +83,7 @@ pub(super) fn peer(
     let us = 1e6 * secs / (atoms * steps);
     Ok(Ok((
         format!(
-            "bench peer=lammps-peri/{style} particles={atoms} steps={steps} threads=1 ranks={ranks} us_per_particle_step={us:.4}\n"
+            "bench peer=lammps-{style} particles={atoms} steps={steps} threads=1 ranks={ranks} us_per_particle_step={us:.4}\n"
         ),
         us,
     )))

@@ -9,6 +9,9 @@ use crate::models::pmb::{Motion, Pmb};
 use std::fmt::Write as _;
 use std::time::Instant;
 
+/// The model the hand-written loop is written for.
+pub(super) const MODEL: &str = Pmb::NAME;
+
 /// The yardstick's line, for a PMB simulation (empty for any other model). Runs alternate
 /// (hand first on even repeats, generic first on odd ones) and the overhead is the median of
 /// the per-repeat ratios, so a slow spell of a shared machine hits both.

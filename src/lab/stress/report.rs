@@ -129,9 +129,19 @@ pub(super) fn failure_section(
         Failure::Impact(100.0),
         Failure::Impact(1000.0),
     ];
-    let jobs: Vec<(&str, Failure)> = models
+    // A model whose sample repeats another's mechanics (thermal without expansion: PMB plus
+    // conduction) would repeat that model's rows.
+    let mut own_mechanics = Vec::new();
+    for &m in models {
+        if sample(m, &solid(CONCRETE_E, 2400.0, FAILURE_S0, false))?
+            .mechanics_of
+            .is_none()
+        {
+            own_mechanics.push(m);
+        }
+    }
+    let jobs: Vec<(&str, Failure)> = own_mechanics
         .iter()
-        .filter(|&&m| m != "thermal")
         .flat_map(|&m| cases.map(|c| (m, c)))
         .collect();
     let rows = side_by_side(&jobs, threads, |&(m, c)| failure(m, c, steps));
