@@ -3,8 +3,8 @@
 //! A case is a deck at a coarse `--quick` or a fine `--full` resolution, a reference value
 //! from a formula (docs/theory.md §7–§8), a tolerance, and an extractor that reads the
 //! measured value from the run's output. The cases are files, `validation/NAME.toml`
-//! (`case_file.rs`), except the lap splices and the girder, still made here (`lap_splice.rs`,
-//! `girder.rs`). The runner writes `report.md` with the table (case, quantity, PDQ, reference,
+//! (`case_file.rs`; their formulas in `formulas.rs`, their measures in `measures.rs`). The
+//! runner writes `report.md` with the table (case, quantity, PDQ, reference,
 //! error, particles, run time) and a PNG plot per case.
 
 use crate::driver::run::{self, RunOptions, Summary};
@@ -18,8 +18,6 @@ use std::time::Instant;
 
 pub mod case_file;
 pub mod formulas;
-mod girder;
-mod lap_splice;
 pub mod measures;
 mod sweep;
 
@@ -255,14 +253,9 @@ pub struct ValidateOptions {
 }
 
 /// The cases of a level, in report order: the files that `dir/suite.toml` lists (the elastic
-/// ones by the implicit solve if `implicit`), then the lap splices and the girder.
+/// ones by the implicit solve if `implicit`).
 pub fn cases(dir: &Path, level: Level, implicit: bool) -> Result<Vec<Case>, String> {
-    let mut all = case_file::load_suite(dir, level, implicit)?;
-    for (suffix, velocity) in lap_splice::VELOCITIES {
-        all.push(lap_splice::lap_splice(level, suffix, velocity));
-    }
-    all.push(girder::prestressed_girder(level));
-    Ok(all)
+    case_file::load_suite(dir, level, implicit)
 }
 
 /// Runs the cases, writes `report.md` into the output directory and returns the table and

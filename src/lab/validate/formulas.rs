@@ -3,13 +3,17 @@
 //! names the file gives — so that a deck a user varies gets its own reference.
 //!
 //! The formulas and their sources are in docs/theory.md §7–§8; the ACI ones are written in psi
-//! and ask for a deck in `units = "in-lbf-s"`.
+//! and ask for a deck in `units = "in-lbf-s"`. The lap splice's (`splice.rs`) and the
+//! pretensioned girder's (`prestressed.rs`) have files of their own.
 
 use crate::input::deck::{LoadKind, Region, Scene};
 use crate::input::geometry::{Op, Shape};
 use crate::input::units::{Dim, UnitSystem};
 use crate::model::{Dimension, Material};
 use serde::Deserialize;
+
+mod prestressed;
+mod splice;
 
 /// A formula and the deck items it reads (`[validation.reference]`).
 #[derive(Clone, Debug, Deserialize)]
@@ -28,6 +32,18 @@ pub enum Formula {
     AciShear {},
     /// The uniform load whose end shear is V_c: w = 2·V_c/L between the support lines.
     AciShearSimplySupported { supports: [String; 2] },
+    /// Orangun–Jirsa–Breen splice strength T = (1.2 + 3c/d_b + 50 d_b/l_s)·√f'c·π·d_b·l_s of
+    /// the deck's two lapped bars in its first cylinder (`splice.rs`).
+    OrangunJirsaBreen {},
+    /// The smaller of ACI 318-11's web-shear (Eq. 11-12) and flexural cracking loads of a
+    /// pretensioned girder at midspan: the deck's first prism along x, its bars (the
+    /// prestressed ones are the strands), the two supports, the midspan load and the gravity
+    /// load (`prestressed.rs`).
+    AciPrestressedCracking {
+        supports: [String; 2],
+        load: String,
+        weight: String,
+    },
 }
 
 /// A curve drawn against the measured one.
@@ -47,6 +63,15 @@ pub struct Reference {
 
 impl Formula {
     pub fn evaluate(&self, scene: &Scene) -> Result<Reference, String> {
+        match self {
+            Formula::OrangunJirsaBreen {} => return splice::reference(scene),
+            Formula::AciPrestressedCracking {
+                supports,
+                load,
+                weight,
+            } => return prestressed::reference(scene, supports, load, weight),
+            _ => {}
+        }
         let beam = Beam::of(scene)?;
         match self {
             Formula::TimoshenkoCantilever { clamp, load } => {
@@ -101,6 +126,9 @@ impl Formula {
                     ),
                     curve: Curve::Level(2.0 * v_c / span * beam.length),
                 })
+            }
+            Formula::OrangunJirsaBreen {} | Formula::AciPrestressedCracking { .. } => {
+                unreachable!("evaluated above")
             }
         }
     }

@@ -32,6 +32,10 @@ pub enum Measure {
         #[serde(default)]
         per_length: bool,
     },
+    /// The largest pull force of a pullout: `grip`'s support reaction along x, over the run,
+    /// drawn against the separation of the two probes `ends` (the gripped bar ends; u_x of
+    /// the second less the first).
+    PeakPull { grip: String, ends: [String; 2] },
 }
 
 impl Measure {
@@ -103,8 +107,38 @@ impl Measure {
                 });
                 (extract, load_against(&load, &probe))
             }
+            Measure::PeakPull { grip, ends } => {
+                let curve = pull_against_separation(&grip, &ends);
+                let extract: Extractor = Box::new(move |_, dir| peak_pull(&curve, dir));
+                (extract, pull_against_separation(&grip, &ends))
+            }
         })
     }
+}
+
+/// The largest force of the (separation, force) curve; an error if one is not finite.
+fn peak_pull(curve: &CurveReader, dir: &Path) -> Result<f64, String> {
+    let curve = curve(dir)?;
+    if let Some(&(_, f)) = curve.iter().find(|(_, f)| !f.is_finite()) {
+        return Err(format!("the pull force in history.csv is not finite ({f})"));
+    }
+    curve
+        .iter()
+        .map(|&(_, f)| f)
+        .reduce(f64::max)
+        .ok_or_else(|| "history.csv has no rows".to_string())
+}
+
+/// (separation of the two gripped bar ends, the grip's reaction along x) over the rows.
+fn pull_against_separation(grip: &str, ends: &[String; 2]) -> CurveReader {
+    let force = format!("reaction_{grip}_x");
+    let (left, right) = (format!("{}_ux", ends[0]), format!("{}_ux", ends[1]));
+    Box::new(move |dir| {
+        let (header, rows) = read_history(dir)?;
+        let col = |name: &str| column(&header, name);
+        let (f, r, l) = (col(&force)?, col(&right)?, col(&left)?);
+        Ok(rows.iter().map(|row| (row[r] - row[l], row[f])).collect())
+    })
 }
 
 /// The length of the loaded region along x when the measure is per length, else 1.
