@@ -127,8 +127,9 @@ impl Formula {
                     curve: Curve::Level(2.0 * v_c / span * beam.length),
                 })
             }
+            // Evaluated above, without a beam; kept an error rather than a panic.
             Formula::OrangunJirsaBreen {} | Formula::AciPrestressedCracking { .. } => {
-                unreachable!("evaluated above")
+                Err(format!("{self:?} is not a beam formula"))
             }
         }
     }
