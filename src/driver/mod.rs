@@ -4,6 +4,7 @@
 //! `check` describes a deck without running it.
 
 mod check;
+mod observers;
 mod record;
 pub mod run;
 mod step_loop;

@@ -9,7 +9,6 @@ use crate::input::deck::SolverSpec;
 use crate::input::setup::Setup;
 use crate::model::attributes::Attributes;
 use crate::model::Model;
-use crate::output::History;
 use crate::parallel::comm::{f64s, Reduce};
 use crate::parallel::Cube;
 use std::fmt::Write as _;
@@ -319,7 +318,6 @@ pub(crate) fn balance_table(rows: &[Vec<f64>], steps: u64) -> String {
 pub(crate) fn finish<M: Model>(
     mut cube: Cube<M>,
     plan: &Plan,
-    mut history: Option<History>,
     tally: Tally,
     seconds: f64,
 ) -> Result<Option<Summary>, String> {
@@ -354,9 +352,6 @@ pub(crate) fn finish<M: Model>(
     );
     if balance.len() > 1 {
         timing.push_str(&balance_table(&balance, steps));
-    }
-    if let Some(h) = history.as_mut() {
-        h.flush().map_err(io)?;
     }
     std::fs::write(plan.dir.join("timing.txt"), &timing).map_err(io)?;
     if plan.final_state {
