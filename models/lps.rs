@@ -17,8 +17,8 @@
 //! (ω = exp(−L²/(0.4δ)²)).
 
 use crate::model::{
-    check_options, stretch_line, BondGeom, Dimension, Material, Model, ModelBuild, ModelError,
-    Sample, SampleOf, Side,
+    check_options, stretch_line, BondGeom, Dimension, ElasticConstant, Isotropic, Material, Model,
+    ModelBuild, ModelError, Sample, SampleOf, Side,
 };
 
 pub use super::pmb::{Force3, Motion};
@@ -356,12 +356,14 @@ fn own_constants(m: &Material, delta: f64) -> Result<(f64, f64, f64), ModelError
         Lps::NAME,
         "one of 'youngs_modulus' or 'bulk_modulus' (with 'poisson_ratio')",
     )?;
-    let k = if which == 0 {
-        value / (3.0 * (1.0 - 2.0 * nu))
+    let given = if which == 0 {
+        ElasticConstant::YoungsModulus(value)
     } else {
-        value
+        ElasticConstant::BulkModulus(value)
     };
-    let g = 3.0 * k * (1.0 - 2.0 * nu) / (2.0 * (1.0 + nu));
+    let elastic =
+        Isotropic::from_any_two(given, ElasticConstant::PoissonRatio(nu)).expect("E or K, with ν");
+    let (k, g) = (elastic.bulk_modulus, elastic.shear_modulus);
     let s = m.critical_stretch_or(|g0| {
         (g0 / ((3.0 * g + 0.75f64.powi(4) * (k - 5.0 * g / 3.0)) * delta)).sqrt()
     })?;

@@ -14,8 +14,8 @@
 //! * A broken bond carries neither force nor heat: a crack insulates.
 
 use crate::model::{
-    bond_based_lame, check_options, stretch_line, BondGeom, Dimension, Material, Model, ModelBuild,
-    ModelError, Sample, SampleOf, Side,
+    bond_based_lame, check_options, stretch_line, BondGeom, Dimension, ElasticConstant, Isotropic,
+    Material, Model, ModelBuild, ModelError, Sample, SampleOf, Side,
 };
 use std::f64::consts::PI;
 
@@ -262,8 +262,14 @@ fn own_constants(m: &Material, delta: f64) -> Result<(Own, f64), ModelError> {
         name,
         "one of 'bulk_modulus' or 'youngs_modulus'",
     )?;
-    // ν = 1/4 is built into the bond-based solid: K = 2E/3.
-    let k_bulk = if which == 0 { value } else { 2.0 * value / 3.0 };
+    // ν = 1/4 is built into the bond-based solid: K = E/(3(1 − 2ν)) = 2E/3.
+    let k_bulk = if which == 0 {
+        value
+    } else {
+        let given = ElasticConstant::YoungsModulus(value);
+        let elastic = Isotropic::from_any_two(given, ElasticConstant::PoissonRatio(0.25));
+        elastic.expect("E with ν").bulk_modulus
+    };
     let c = 18.0 * k_bulk / (PI * delta.powi(4));
     let s0 = m.critical_stretch_or(|g0| (10.0 * g0 / (PI * c * delta.powi(5))).sqrt())?;
     let conductivity = m.positive("thermal_conductivity", Dimension::NUMBER)?;

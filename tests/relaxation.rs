@@ -95,12 +95,7 @@ fn relaxation_gives_the_same_equilibrium_on_several_procubes() {
 
 #[test]
 fn relaxation_refuses_a_temperature_model() {
-    let text = bar_deck("pmb", "adr")
-        .replace("name = \"pmb\"", "name = \"thermal\"")
-        .replace(
-            "bulk_modulus = \"14.9 GPa\"\n",
-            "bulk_modulus = \"14.9 GPa\"\nthermal_conductivity = 2.0\nspecific_heat = 900.0\n",
-        );
+    let text = bar_deck("thermal", "adr");
     let scene = deck::parse(&text, "bar.toml", "bar").unwrap();
     let e = run(
         &scene,

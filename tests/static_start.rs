@@ -199,12 +199,7 @@ fn what_a_static_start_cannot_do_is_refused_on_the_time_line() {
     ));
     assert!(e.contains("at rest"), "{e}");
     // With temperature.
-    let e = refused(
-        &text.replace("name = \"pmb\"", "name = \"thermal\"").replace(
-            "critical_stretch = 0.05",
-            "critical_stretch = 0.05\nthermal_conductivity = 2.0\nspecific_heat = 900.0\nthermal_expansion = 1e-5",
-        ),
-    );
+    let e = refused(&started_deck("thermal", 60));
     assert!(e.contains("temperature"), "{e}");
     // With periodic axes.
     let e = refused(&text.replace(
@@ -217,7 +212,7 @@ fn what_a_static_start_cannot_do_is_refused_on_the_time_line() {
     // converges); the run would stop after one step.
     let e = refused(
         &text
-            .replace("critical_stretch = 0.05", "critical_stretch = 1.2e-5")
+            .replace("critical_stretch = 5e-2", "critical_stretch = 1.2e-5")
             .replace("steps = 60", "steps = 60\nstop_at_broken_bonds = 1"),
     );
     assert!(
@@ -225,7 +220,7 @@ fn what_a_static_start_cannot_do_is_refused_on_the_time_line() {
         "{e}"
     );
     // A load the structure cannot stand: the static solve does not converge.
-    let e = refused(&text.replace("critical_stretch = 0.05", "critical_stretch = 1e-7"));
+    let e = refused(&text.replace("critical_stretch = 5e-2", "critical_stretch = 1e-7"));
     assert!(
         e.contains("did not converge") || e.contains("singular"),
         "{e}"

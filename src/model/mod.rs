@@ -5,11 +5,13 @@
 //! `M: Model`, so each model gets its own monomorphized step with no dynamic dispatch per bond.
 
 pub mod attributes;
+pub mod elastic;
 pub mod lanes;
 pub mod material;
 pub mod rotation;
 pub mod sample;
 
+pub use elastic::{ElasticConstant, Isotropic};
 pub use material::{Dimension, Material, MaterialKind, ModelError, PairTable, Units, Written};
 pub use sample::{stretch_line, Sample, SampleOf};
 

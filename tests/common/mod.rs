@@ -12,62 +12,75 @@ pub fn max_relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
         / scale
 }
 
-/// The notched-pull deck of the layout tests (`tests/decks/notched_pull.toml`, PMB) made over
-/// for another model: the state pass (`lps`), rotations with a relative-rotation stiffness
-/// (`micropolar`), or heat generated in one slab, held cold in another and conducted across
-/// procCube faces into thermal expansion (`thermal`). Each still cracks within its 500 steps.
+/// The tests' solid, in the model's own keys (its sample, [`pdq::model::Model::sample`]): a
+/// rock of K = 14.9 GPa at ν = ¼ (E = 22.35 GPa), 2200 kg/m³, bonds breaking at `s0`;
+/// `full`: with the model's optional terms (thermal expansion, relative-rotation stiffness).
 #[allow(dead_code)]
-pub fn model_pull_deck(model: &str) -> String {
-    let base = include_str!("../decks/notched_pull.toml");
-    let rock =
-        "density = \"2200 kg/m^3\"\nbulk_modulus = \"14.9 GPa\"\ncritical_stretch = 0.0005\n";
-    assert!(base.contains(rock) && base.contains("name = \"pmb\""));
-    let (material, extra) = match model {
-        "lps" => (
-            "density = \"2200 kg/m^3\"\nbulk_modulus = \"14.9 GPa\"\npoisson_ratio = 0.3\ncritical_stretch = 0.0005\n",
-            "",
-        ),
-        "micropolar" => (
-            "density = \"2200 kg/m^3\"\nyoungs_modulus = \"26.8 GPa\"\npoisson_ratio = 0.2\ncritical_stretch = 0.0005\n",
-            "[model.options]\nkappa = 0.05\n",
-        ),
-        "thermal" => (
-            "density = \"2200 kg/m^3\"\nbulk_modulus = \"14.9 GPa\"\ncritical_stretch = 0.0005\nthermal_conductivity = 2.0\nspecific_heat = 900.0\nthermal_expansion = 1e-5\n",
-            "[[load]]\nname = \"heater\"\nregion = { shape = \"slab\", axis = \"y\", from = \"0 mm\", to = \"2 mm\" }\nheat_source = 2e12\n[[boundary]]\nname = \"cold\"\nregion = { shape = \"box\", min = \"5 8 0 mm\", max = \"25 10 10 mm\" }\ntemperature = 0.0\n",
-        ),
-        other => panic!("no pull deck for model '{other}'"),
-    };
-    let text = base
-        .replace("name = \"pmb\"", &format!("name = \"{model}\""))
-        .replace(rock, material);
-    // `[model.options]` must follow `[model]`; the other additions go at the end.
-    if extra.starts_with("[model.options]") {
-        text.replace("[lattice]", &format!("{extra}[lattice]"))
+pub fn rock(model: &str, s0: f64, full: bool) -> (pdq::model::ModelInfo, pdq::model::Sample) {
+    let info = pdq::models::find(model).unwrap_or_else(|| panic!("no model '{model}'"));
+    let sample = info
+        .sample(&pdq::model::SampleOf::Solid {
+            youngs_modulus: 22.35e9,
+            density: 2200.0,
+            critical_stretch: s0,
+            steel: false,
+            full,
+        })
+        .unwrap_or_else(|| panic!("model '{model}' has no sample material"));
+    (info, sample)
+}
+
+/// `[model.options]` with these lines, or nothing.
+fn options_table(options: &str) -> String {
+    if options.is_empty() {
+        String::new()
     } else {
-        format!("{text}{extra}")
+        format!("[model.options]\n{options}")
     }
 }
 
-/// A bar 40 × 6 × 6 mm held at x ≤ 3 mm and pulled by 10 N at x ≥ 37 mm in four load steps
-/// solved by `kind` (`adr` or `implicit`) to 10⁻⁹ (tests/relaxation.rs, tests/implicit.rs).
+/// The notched-pull deck of the layout tests (`tests/decks/notched_pull.toml`, PMB) made over
+/// for any registered model with its full sample rock: a state pass (`lps`), rotations with
+/// a relative-rotation stiffness (`micropolar`); a model with first-order DOFs (`thermal`)
+/// also gets heat generated in one slab and held cold in another, conducted across procCube
+/// faces into thermal expansion. Each still cracks within its 500 steps.
+#[allow(dead_code)]
+pub fn model_pull_deck(model: &str) -> String {
+    let base = include_str!("../decks/notched_pull.toml");
+    let rock_lines =
+        "density = \"2200 kg/m^3\"\nbulk_modulus = \"14.9 GPa\"\ncritical_stretch = 0.0005\n";
+    assert!(base.contains(rock_lines) && base.contains("name = \"pmb\""));
+    let (info, sample) = rock(model, 0.0005, true);
+    let mut text = base
+        .replace("name = \"pmb\"", &format!("name = \"{model}\""))
+        .replace(rock_lines, &sample.material)
+        // `[model.options]` must follow `[model]`.
+        .replace(
+            "[lattice]",
+            &format!("{}[lattice]", options_table(&sample.options)),
+        );
+    if info.first_order > 0 {
+        text.push_str("[[load]]\nname = \"heater\"\nregion = { shape = \"slab\", axis = \"y\", from = \"0 mm\", to = \"2 mm\" }\nheat_source = 2e12\n[[boundary]]\nname = \"cold\"\nregion = { shape = \"box\", min = \"5 8 0 mm\", max = \"25 10 10 mm\" }\ntemperature = 0.0\n");
+    }
+    text
+}
+
+/// A bar 40 × 6 × 6 mm of the model's plain sample rock, held at x ≤ 3 mm and pulled by 10 N
+/// at x ≥ 37 mm in four load steps solved by `kind` (`adr` or `implicit`) to 10⁻⁹
+/// (tests/relaxation.rs, tests/implicit.rs).
 #[allow(dead_code)]
 pub fn bar_deck(model: &str, kind: &str) -> String {
-    let material = match model {
-        "micropolar" => "youngs_modulus = \"22.35 GPa\"\npoisson_ratio = 0.2\n",
-        "lps" => "bulk_modulus = \"14.9 GPa\"\npoisson_ratio = 0.3\n",
-        _ => "bulk_modulus = \"14.9 GPa\"\n",
-    };
+    let (_, sample) = rock(model, 0.05, false);
+    let (options, material) = (options_table(&sample.options), sample.material);
     format!(
         r#"units = "SI"
 [model]
 name = "{model}"
 horizon = "3.015 mm"
-[lattice]
+{options}[lattice]
 spacing = "1 mm"
 [materials.rock]
-density = "2200 kg/m^3"
-{material}critical_stretch = 0.05
-[[geometry]]
+{material}[[geometry]]
 shape = "box"
 material = "rock"
 min = "0 0 0 mm"
