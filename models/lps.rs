@@ -158,13 +158,18 @@ impl Model for Lps {
                 "density = {density}\nbulk_modulus = 14.9e9\npoisson_ratio = 0.125\ncritical_stretch = {critical_stretch}\n"
             ))
             .with_options("influence = \"inverse_length\"\n"),
+            // Plain: ν = ¼, where the dilatation term vanishes (3K − 5G = 0) and LPS is the
+            // bond-based solid (what `pdq stress` compares). Full: ν = 0.3, so that the state
+            // pass and the dilatation term carry force (the tests' decks).
             SampleOf::Solid {
                 youngs_modulus,
                 density,
                 critical_stretch,
+                full,
                 ..
             } => Sample::new(format!(
-                "density = {density}\nyoungs_modulus = {youngs_modulus:e}\npoisson_ratio = 0.25\n{}",
+                "density = {density}\nyoungs_modulus = {youngs_modulus:e}\npoisson_ratio = {}\n{}",
+                if full { 0.3 } else { 0.25 },
                 stretch_line("critical_stretch", critical_stretch)
             )),
         })

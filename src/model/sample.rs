@@ -24,7 +24,7 @@ pub enum SampleOf {
     /// `critical_stretch` (∞: never, and the key is left out), numbers in exponent form.
     /// `steel`: the steel of a steel–concrete mix (a model without a steel kind gives its
     /// solid). `full`: the model's optional terms switched on (thermal expansion, micropolar's
-    /// relative-rotation stiffness), for tests that exercise all of its data; without them
+    /// relative-rotation stiffness, LPS's dilatation term at ν ≠ ¼), for tests that exercise all of its data; without them
     /// the plain law, whose mechanical energy is conserved on its own (`pdq stress`).
     Solid {
         youngs_modulus: f64,

@@ -70,7 +70,8 @@ pub fn model_pull_deck(model: &str) -> String {
 /// (tests/relaxation.rs, tests/implicit.rs).
 #[allow(dead_code)]
 pub fn bar_deck(model: &str, kind: &str) -> String {
-    let (_, sample) = rock(model, 0.05, false);
+    // The full sample: LPS at ν ≠ ¼ (its dilatation term on), micropolar with kappa.
+    let (_, sample) = rock(model, 0.05, true);
     let (options, material) = (options_table(&sample.options), sample.material);
     format!(
         r#"units = "SI"
