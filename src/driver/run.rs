@@ -267,6 +267,13 @@ impl<M: Model> Prepared<'_, M> {
         resume.or(self.static_start.as_ref().map(|s| &s.state))
     }
 
+    /// The whole scene, to be kept by the root for its frames, and the state the procCubes
+    /// start from (as [`Self::start_state`]), once the procCubes are built.
+    fn into_start(self) -> (Setup<M>, Option<Snapshot>) {
+        let start = self.resume.map(|c| c.state);
+        (self.setup, start.or(self.static_start.map(|s| s.state)))
+    }
+
     /// What the step loop needs to know about the run on `layout`.
     fn plan(&self, layout: &Layout) -> Plan {
         let (setup, scene, out) = (&self.setup, self.scene, &self.scene.output);
@@ -336,14 +343,8 @@ impl<M: Model> Prepared<'_, M> {
         let plans = crate::parallel::decomposition::cell_plans(&layout);
         let cube = parallel::build_cube(&self.setup, &layout, &plans, rank, Box::new(mpi));
         let p = self.plan(&layout);
-        let Prepared {
-            setup,
-            resume,
-            static_start,
-            ..
-        } = self;
-        let start = resume.as_ref().map(|c| &c.state);
-        let start = start.or(static_start.as_ref().map(|s| &s.state));
+        let (setup, start) = self.into_start();
+        let start = start.as_ref();
         let store = (rank == 0).then(|| frame_store(setup));
         match drive(cube, &p, store, start)? {
             Some(s) => {
@@ -373,14 +374,8 @@ impl<M: Model> Prepared<'_, M> {
         self.say_static(opts.quiet);
         let cubes = parallel::thread_cubes(&self.setup, &layout);
         let p = self.plan(&layout);
-        let Prepared {
-            setup,
-            resume,
-            static_start,
-            ..
-        } = self;
-        let start = resume.as_ref().map(|c| &c.state);
-        let start = start.or(static_start.as_ref().map(|s| &s.state));
+        let (setup, start) = self.into_start();
+        let start = start.as_ref();
         let store = std::sync::Mutex::new(Some(frame_store(setup)));
         let results = parallel::on_threads(cubes, |cube| {
             let s = if cube.plan.rank == 0 {
