@@ -5,7 +5,6 @@ use super::ranks::mpirun;
 use super::BenchOptions;
 use std::process::Command;
 
-/// The LAMMPS input of the peer benchmark (`shared/bench/lammps_pmb.in`).
 /// The LAMMPS input of the LPS peer benchmark (`shared/bench/lammps_lps.in`).
 const LAMMPS_LPS: &str = "units si\nboundary s s s\natom_style peri\natom_modify map array\nlattice sc 0.001\nregion box block 0 ${n} 0 ${n} 0 ${n}\ncreate_box 1 box\ncreate_atoms 1 region box\npair_style peri/lps\npair_coeff * * 14.9e9 14.9e9 0.0030150 0.0005 0.25\nset group all density 2200\nset group all volume 1.0e-9\nvelocity all set 0.0 0.0 0.0 sum no units box\nregion top block INF INF INF INF $(v_n-2) ${n} units lattice\ngroup top region top\nvelocity top set 0.0 0.0 1.0 sum no units box\nneighbor 0.0010 bin\nfix 1 all nve\ntimestep 1.0e-7\nthermo 100\nrun ${steps}\n";
 
