@@ -53,6 +53,11 @@ impl Dimension {
     pub const ENERGY_PER_AREA: Dimension = Dimension::new(1, 0, -2);
     /// Force per volume² per length (N/m⁶): the bond micromodulus.
     pub const MICROMODULUS: Dimension = Dimension::new(1, -5, -2);
+    /// Energy (J): pair-law well depths.
+    pub const ENERGY: Dimension = Dimension::new(1, 2, -2);
+    /// One over a length (1/m): the Morse width.
+    pub const INVERSE_LENGTH: Dimension = Dimension::new(0, -1, 0);
+    pub const MASS: Dimension = Dimension::new(1, 0, 0);
 }
 
 /// A value as the deck wrote it.

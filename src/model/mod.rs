@@ -8,6 +8,7 @@ pub mod attributes;
 pub mod elastic;
 pub mod lanes;
 pub mod material;
+pub mod pair;
 pub mod rotation;
 pub mod sample;
 
