@@ -20,6 +20,8 @@
 pub mod model;
 #[path = "../models/mod.rs"]
 pub mod models;
+#[path = "../pairs/mod.rs"]
+pub mod pairs;
 
 pub mod engine;
 pub mod input;

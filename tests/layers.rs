@@ -12,7 +12,7 @@ const LAYERS: [&str; 8] = [
 
 fn rank(layer: &str) -> Option<usize> {
     match layer {
-        "models" => Some(0),
+        "models" | "pairs" => Some(0),
         _ => LAYERS.iter().position(|l| *l == layer),
     }
 }
@@ -36,7 +36,7 @@ fn layer_of(root: &Path, file: &Path) -> Option<String> {
         .map(|c| c.to_string_lossy().to_string())
         .collect();
     match parts.as_slice() {
-        [top, ..] if top == "models" => Some("models".into()),
+        [top, ..] if top == "models" || top == "pairs" => Some(top.clone()),
         [src, layer, _, ..] if src == "src" => Some(layer.clone()),
         _ => None, // lib.rs, main.rs: above every layer
     }
@@ -74,6 +74,7 @@ fn all_sources() -> Vec<PathBuf> {
     let mut files = Vec::new();
     sources(&root.join("src"), &mut files);
     sources(&root.join("models"), &mut files);
+    sources(&root.join("pairs"), &mut files);
     files.sort();
     files
 }
@@ -89,7 +90,7 @@ fn no_module_uses_a_layer_above_its_own() {
         let own = rank(&layer).unwrap_or_else(|| panic!("{} is in no layer", file.display()));
         let text = std::fs::read_to_string(&file).unwrap();
         for (line, name) in crate_paths(&text) {
-            if layer == "models" && name != "model" && name != "models" {
+            if (layer == "models" || layer == "pairs") && name != "model" && name != "models" {
                 up.push(format!(
                     "{}:{line}: a model file uses crate::{name} (models see only crate::model)",
                     file.display()

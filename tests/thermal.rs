@@ -68,7 +68,7 @@ fn erf_error(threads: usize, safety: f64) -> Conduction {
     let rows = parallel::on_threads(cubes, |mut c| {
         c.start();
         for _ in 0..steps {
-            c.advance();
+            c.advance().unwrap();
         }
         let p = &c.sim.particles;
         (0..p.n_owned)

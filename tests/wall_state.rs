@@ -56,7 +56,7 @@ fn run(
     let parts = parallel::on_threads(cubes, |mut c| {
         c.start();
         for _ in 0..steps {
-            c.advance();
+            c.advance().unwrap();
         }
         let p = &c.sim.particles;
         let own: Vec<(u32, [f64; 3], f64)> = (0..p.n_owned)

@@ -114,7 +114,7 @@ pub fn check(scene: &Scene) -> Result<String, String> {
     impl ModelVisitor for Visit<'_> {
         type Output = Result<String, String>;
         fn visit<M: Model>(self, model: M) -> Self::Output {
-            let mut setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
+            let setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
             let mut s = describe(&setup, self.0);
             // The deck's layout is checked here too, so a run does not find it wrong later.
             let threads = self.0.parallel.threads;
@@ -127,9 +127,19 @@ pub fn check(scene: &Scene) -> Result<String, String> {
             );
             let _ = writeln!(s, "setup      {:.2} s", setup.seconds);
             let calib = 5.min(setup.steps.max(1));
+            // One procCube of the whole scene, as a one-thread run steps it (with a pair law,
+            // its neighbour lists come from the procCube's cells).
+            let one = crate::parallel::layout(
+                &setup,
+                &crate::parallel::decomposition::Procs::Given([1, 1, 1]),
+                1,
+                crate::parallel::decomposition::Walls::Whole,
+            )?;
+            let mut cube = crate::parallel::thread_cubes(&setup, &one).remove(0);
+            cube.start();
             let t = Instant::now();
             for _ in 0..calib {
-                setup.sim.advance();
+                cube.advance()?;
             }
             let per_step = t.elapsed().as_secs_f64() / calib as f64;
             let _ = writeln!(

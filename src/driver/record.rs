@@ -27,6 +27,12 @@ pub(crate) fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
     .iter()
     .map(|s| s.to_string())
     .collect();
+    if setup.sim.pairs.is_some() {
+        // total_energy then includes the pairs' energy.
+        for k in ["pair_energy", "pair_virial", "pairs_in_range"] {
+            c.push(k.into());
+        }
+    }
     for l in &setup.sim.loads {
         c.push(format!("load_{}", l.name));
     }
@@ -78,6 +84,8 @@ pub(crate) struct Row {
     pub strain_energy: f64,
     pub broken_bonds: u64,
     pub max_damage: f64,
+    /// With a pair law: the pairs' energy, virial Σ r·F and the pairs within their cutoff.
+    pub pairs: Option<[f64; 3]>,
     /// Each load's total along its direction, in deck order.
     pub loads: Vec<f64>,
     /// Each constraint's reaction on each of its DOFs, in deck order.
@@ -98,10 +106,11 @@ impl Row {
             self.time,
             self.kinetic_energy,
             self.strain_energy,
-            self.kinetic_energy + self.strain_energy,
+            self.kinetic_energy + self.strain_energy + self.pairs.map_or(0.0, |p| p[0]),
             self.broken_bonds as f64,
             self.max_damage,
         ];
+        v.extend(self.pairs.iter().flatten());
         v.extend_from_slice(&self.loads);
         v.extend_from_slice(&self.reactions);
         v.extend(self.probes.iter().flatten());
@@ -120,6 +129,7 @@ impl Row {
         let (ke, se) = (sim.kinetic_energy(), sim.strain_energy());
         let mut sums = vec![ke, se, cube.broken_count() as f64];
         let n_loads = sim.loads.len();
+        let pairs = sim.pairs.as_ref().map(|p| p.tally());
         for l in &sim.loads {
             let t = l.total(sim.time);
             let norm = (l.vector[0].powi(2) + l.vector[1].powi(2) + l.vector[2].powi(2)).sqrt();
@@ -148,6 +158,9 @@ impl Row {
                 .map(|f| f * f)
                 .sum(),
         );
+        if let Some(t) = pairs {
+            sums.extend([t.energy, t.virial, t.pairs as f64]);
+        }
         let (step, time) = (sim.step, sim.time);
         let mut team = cube.team();
         team.reduce(&mut sums, Reduce::Sum);
@@ -167,6 +180,10 @@ impl Row {
             reactions: sums[3 + n_loads..first_probe].to_vec(),
             probes,
             residual_force: sums[first_probe + 3 * n_probes].sqrt(),
+            pairs: pairs.map(|_| {
+                let at = first_probe + 3 * n_probes + 1;
+                [sums[at], sums[at + 1], sums[at + 2]]
+            }),
             solve: None,
         }
     }

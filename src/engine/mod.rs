@@ -9,6 +9,7 @@ pub mod boundary;
 pub mod cells;
 pub mod correction;
 pub mod forces;
+pub mod pair_pass;
 pub mod particles;
 pub mod random;
 pub mod simulation;

@@ -12,6 +12,7 @@
 use crate::engine::bonds::BondList;
 use crate::engine::boundary::{Constraint, Load};
 use crate::engine::forces;
+use crate::engine::pair_pass::NonBonded;
 use crate::engine::particles::Particles;
 use crate::engine::timing::{Phase, Timing};
 use crate::model::attributes::Attributes;
@@ -74,6 +75,8 @@ pub struct Simulation<M: Model> {
     pub time: f64,
     pub step: u64,
     pub timing: Timing,
+    /// The non-bonded pass, if the deck has a `[pair]` law; `None` costs nothing.
+    pub pairs: Option<Box<dyn NonBonded<M>>>,
 }
 
 impl<M: Model> Simulation<M> {
@@ -89,6 +92,7 @@ impl<M: Model> Simulation<M> {
             time: 0.0,
             step: 0,
             timing: Timing::default(),
+            pairs: None,
         }
     }
 
@@ -128,6 +132,10 @@ impl<M: Model> Simulation<M> {
         }
         let broken = forces::pair_pass(&self.model, p, &mut self.bonds);
         t = self.timing.lap(Phase::Forces, t);
+        if let Some(pairs) = &mut self.pairs {
+            pairs.add_forces(p);
+            t = self.timing.lap(Phase::Pairs, t);
+        }
         exchange.reverse_force(p);
         t = self.timing.lap(Phase::Communication, t);
         for load in &self.loads {
@@ -187,6 +195,16 @@ impl<M: Model> Simulation<M> {
 
     /// [`Simulation::advance`] with ghost data moved by `exchange`.
     pub fn advance_with(&mut self, exchange: &mut impl Exchange<M>) -> usize {
+        self.begin_step();
+        let broken = self.compute_forces_with(exchange);
+        self.end_step();
+        broken
+    }
+
+    /// The part of a step before its force evaluation: first-order DOFs, the first kick, the
+    /// drift; time and step count move on. A procCube refreshes its neighbour lists between
+    /// this and the forces.
+    pub fn begin_step(&mut self) {
         let (dt, t0) = (self.dt, self.time);
         let start = Instant::now();
         self.advance_first_order(dt);
@@ -201,16 +219,18 @@ impl<M: Model> Simulation<M> {
         self.time = t0 + dt;
         self.step += 1;
         self.timing.lap(Phase::Integration, start);
-        let broken = self.compute_forces_with(exchange);
+    }
+
+    /// The part of a step after its force evaluation: the second kick, constraints.
+    pub fn end_step(&mut self) {
         let start = Instant::now();
         if self.integrator == Integrator::VelocityVerlet {
-            self.kick(0.5 * dt);
+            self.kick(0.5 * self.dt);
         }
         for c in &self.constraints {
-            c.set_velocity(&mut self.particles, self.time, dt);
+            c.set_velocity(&mut self.particles, self.time, self.dt);
         }
         self.timing.lap(Phase::Integration, start);
-        broken
     }
 
     pub fn strain_energy(&self) -> f64 {

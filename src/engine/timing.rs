@@ -9,6 +9,8 @@ pub enum Phase {
     Setup,
     State,
     Forces,
+    /// The non-bonded pass and its neighbour-list builds.
+    Pairs,
     Communication,
     Boundary,
     Integration,
@@ -16,10 +18,11 @@ pub enum Phase {
 }
 
 impl Phase {
-    pub const ALL: [Phase; 7] = [
+    pub const ALL: [Phase; 8] = [
         Phase::Setup,
         Phase::State,
         Phase::Forces,
+        Phase::Pairs,
         Phase::Communication,
         Phase::Boundary,
         Phase::Integration,
@@ -31,6 +34,7 @@ impl Phase {
             Phase::Setup => "setup",
             Phase::State => "state pass",
             Phase::Forces => "forces",
+            Phase::Pairs => "pair forces",
             Phase::Communication => "communication",
             Phase::Boundary => "boundary/loads",
             Phase::Integration => "integration",
@@ -41,7 +45,7 @@ impl Phase {
 
 #[derive(Clone, Debug, Default)]
 pub struct Timing {
-    spent: [Duration; 7],
+    spent: [Duration; 8],
 }
 
 impl Timing {

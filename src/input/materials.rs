@@ -135,3 +135,40 @@ pub(super) fn read(
     material.compressive_strength = compressive_strength;
     Ok((material, lines))
 }
+
+/// A table of pair-law keys (`[pair.materials.NAME]`, `[[pair.between]]`) as a [`Material`]
+/// called `name` with number `index`, every key handed on as written (less those in `skip`),
+/// so that a pair law reads them with units checked like a model's.
+pub(super) fn read_keys(
+    name: &str,
+    index: u16,
+    table: &MaterialSection,
+    skip: &[&str],
+    line: usize,
+    sys: UnitSystem,
+    line_of: &dyn Fn(&Spanned<MaterialValue>) -> usize,
+) -> Result<(Material, MaterialLines), (usize, String)> {
+    let keys = table
+        .iter()
+        .filter(|(k, _)| !skip.contains(&k.as_str()))
+        .map(|(k, v)| (k.clone(), v.get_ref().written()))
+        .collect();
+    let lines = MaterialLines {
+        line,
+        keys: table.iter().map(|(k, v)| (k.clone(), line_of(v))).collect(),
+    };
+    let material = Material::new(name, index, MaterialKind::Solid, 0.0, keys, sys.as_units())
+        .map_err(|e| (lines.of(&e), e.to_string()))?;
+    Ok((material, lines))
+}
+
+/// The two material names of a `[[pair.between]]` table's `materials = ["a", "b"]`.
+pub(super) fn pair_names(table: &MaterialSection) -> Option<[String; 2]> {
+    match table.get("materials").map(|v| v.get_ref()) {
+        Some(MaterialValue::Other(toml::Value::Array(a))) if a.len() == 2 => match (&a[0], &a[1]) {
+            (toml::Value::String(x), toml::Value::String(y)) => Some([x.clone(), y.clone()]),
+            _ => None,
+        },
+        _ => None,
+    }
+}

@@ -337,7 +337,7 @@ fn checkpoint_line<M: Model>(
     let steps = 100;
     let t = std::time::Instant::now();
     for _ in 0..steps {
-        cube.advance();
+        cube.advance()?;
     }
     let step_seconds = t.elapsed().as_secs_f64();
     let dir = std::env::temp_dir().join(format!("pdq-bench-checkpoint-{}", std::process::id()));

@@ -48,7 +48,8 @@ pub struct PairBuild<'a> {
     pub own: &'a [Material],
     /// Parameters given for one pair of materials (`[[pair.between]]`): they replace the mixed
     /// values for that pair, both ways round. The `Material` holds the pair's keys; its index
-    /// is the first material's.
+    /// counts on past the materials' (`own.len() + k` for the k-th table), so that an error
+    /// about it points at its table.
     pub between: &'a [(u16, u16, Material)],
     pub mixing: Mixing,
     /// The cutoff the deck gives for every pair (`[pair] cutoff`), if any, in length units.
@@ -166,4 +167,99 @@ macro_rules! pair_registry {
             Err(format!("unknown pair law '{}' (known laws: {})", name, names().join(", ")).into())
         }
     };
+}
+
+impl PairBuild<'_> {
+    /// Refuses keys a law does not read, in every material's and pair's table.
+    pub fn only_uses(&self, law: &str, keys: &[(&str, &str)]) -> Result<(), ModelError> {
+        let names: Vec<&str> = keys.iter().map(|(k, _)| *k).collect();
+        for m in self
+            .own
+            .iter()
+            .chain(self.between.iter().map(|(_, _, m)| m))
+        {
+            if let Some(k) = m.given().find(|k| !names.contains(k)) {
+                return Err(m.key_error(
+                    k,
+                    format!(
+                        "pair law '{law}' does not use '{k}' (it reads {})",
+                        if names.is_empty() {
+                            "no keys".to_string()
+                        } else {
+                            names.join(", ")
+                        }
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The value of `key` for materials `a` and `b` in the deck's units: the one
+    /// `[[pair.between]]` gives, else `mix` of both materials' own values; `None` if neither.
+    /// A pair where only one material gives the key is an error naming the other.
+    pub fn value(
+        &self,
+        a: u16,
+        b: u16,
+        key: &str,
+        dim: crate::model::Dimension,
+        mix: impl Fn(f64, f64) -> f64,
+    ) -> Result<Option<f64>, ModelError> {
+        if let Some(m) = self.between(a, b) {
+            if let Some(v) = m.positive(key, dim)? {
+                return Ok(Some(v));
+            }
+        }
+        let (ma, mb) = (&self.own[a as usize], &self.own[b as usize]);
+        match (ma.positive(key, dim)?, mb.positive(key, dim)?) {
+            (Some(x), Some(y)) => Ok(Some(if a == b { x } else { mix(x, y) })),
+            (None, None) => Ok(None),
+            (Some(_), None) => Err(mb.error(format!(
+                "[pair.materials.{}] gives no '{key}' but material '{}' does: give it for both or in a [[pair.between]] table",
+                mb.name, ma.name
+            ))),
+            (None, Some(_)) => Err(ma.error(format!(
+                "[pair.materials.{}] gives no '{key}' but material '{}' does: give it for both or in a [[pair.between]] table",
+                ma.name, mb.name
+            ))),
+        }
+    }
+
+    /// [`PairBuild::value`] that must be there.
+    pub fn required(
+        &self,
+        a: u16,
+        b: u16,
+        key: &str,
+        dim: crate::model::Dimension,
+        mix: impl Fn(f64, f64) -> f64,
+        law: &str,
+    ) -> Result<f64, ModelError> {
+        self.value(a, b, key, dim, mix)?.ok_or_else(|| {
+            self.own[a as usize].error(format!(
+                "pair law '{law}' needs '{key}' for materials '{}' and '{}': give it in [pair.materials.NAME] or [[pair.between]]",
+                self.own[a as usize].name, self.own[b as usize].name
+            ))
+        })
+    }
+
+    /// Every pair of materials' coefficients from `of(a, b)`, in a [`PairTable`]; the first
+    /// error stops.
+    pub fn table<C: Copy>(
+        &self,
+        of: impl Fn(u16, u16) -> Result<C, ModelError>,
+    ) -> Result<crate::model::PairTable<C>, ModelError> {
+        let n = self.own.len() as u16;
+        let mut all = Vec::with_capacity(n as usize * n as usize);
+        for a in 0..n {
+            for b in 0..n {
+                all.push(of(a, b)?);
+            }
+        }
+        let index: Vec<u16> = (0..n).collect();
+        Ok(crate::model::PairTable::new(&index, |&a, &b| {
+            all[a as usize * n as usize + b as usize]
+        }))
+    }
 }

@@ -37,6 +37,9 @@ pub struct Cube<M: Model> {
     pub lost: Vec<u32>,
     /// Those bonds as (smaller, larger) global ids, kept by the owner of the smaller.
     pub dropped: Vec<(u32, u32)>,
+    /// A bond broke since the neighbour lists were built: pairs they left out as bonded may
+    /// now touch, so the next step rebuilds them.
+    pub(crate) broke_since_build: bool,
 }
 
 /// Boundary conditions, loads and probes of the whole scene, by global id.
@@ -186,6 +189,7 @@ pub fn build_cube<M: Model>(
     sim.integrator = setup.sim.integrator;
     sim.constraints = constraints;
     sim.loads = loads;
+    sim.pairs = setup.sim.pairs.as_ref().map(|p| p.fresh());
     let wall = WallExchange::new(plan.stages.clone(), transport);
     Cube {
         wall,
@@ -197,6 +201,7 @@ pub fn build_cube<M: Model>(
         global_particles: g.len(),
         everywhere,
         dropped: Vec::new(),
+        broke_since_build: false,
     }
 }
 
@@ -257,12 +262,62 @@ impl<M: Model> Cube<M> {
         for c in &self.sim.constraints {
             c.set_velocity(&mut self.sim.particles, self.sim.time, self.sim.dt);
         }
+        if self.sim.pairs.is_some() {
+            self.rebuild_pairs();
+        }
         self.compute_forces();
     }
 
-    /// One time step, ghosts exchanged with the neighbours; the bonds that broke in it.
-    pub fn advance(&mut self) -> usize {
-        self.sim.advance_with(&mut self.wall)
+    /// One time step, ghosts exchanged with the neighbours; the bonds that broke in it. Fails
+    /// only if a neighbour-list rebuild's shuffle does.
+    pub fn advance(&mut self) -> Result<usize, String> {
+        self.sim.begin_step();
+        if self.sim.pairs.is_some() {
+            self.refresh_pairs()?;
+        }
+        let broken = self.sim.compute_forces_with(&mut self.wall);
+        self.broke_since_build |= broken > 0;
+        self.sim.end_step();
+        Ok(broken)
+    }
+
+    /// Rebuilds the neighbour lists when some particle, on any procCube, has moved more than
+    /// half the skin since they were built. Ownership and ghosts are redrawn first (a shuffle
+    /// from current positions), so that every pair within reach lies in neighbouring cells
+    /// and is found once. Every worker must call it at every step: the test is a reduction.
+    fn refresh_pairs(&mut self) -> Result<(), String> {
+        let t = std::time::Instant::now();
+        let far = self.broke_since_build
+            || self
+                .sim
+                .pairs
+                .as_ref()
+                .is_some_and(|pairs| pairs.moved_too_far(&self.sim.particles));
+        if self.team().max(if far { 1.0 } else { 0.0 }) > 0.0 {
+            self.shuffle_now()?;
+            self.build_pair_list();
+        }
+        self.sim.timing.lap(crate::engine::timing::Phase::Pairs, t);
+        Ok(())
+    }
+
+    /// Redraws ownership from current positions and builds the neighbour lists (the start of
+    /// a run with a pair law; every worker must call it).
+    fn rebuild_pairs(&mut self) {
+        // Ghosts must hold current positions (a restart restored only the owned ones).
+        crate::engine::simulation::Exchange::forward(&mut self.wall, &mut self.sim.particles);
+        self.build_pair_list();
+    }
+
+    fn build_pair_list(&mut self) {
+        self.broke_since_build = false;
+        if let Some(pairs) = &mut self.sim.pairs {
+            let cells = crate::engine::pair_pass::CellPairs {
+                cell_range: &self.plan.cell_range,
+                half_shell: &self.plan.half_shell,
+            };
+            pairs.rebuild(&self.sim.particles, &cells, &self.sim.bonds);
+        }
     }
 
     /// Forces at the current state, ghosts exchanged; the bonds that broke.
@@ -388,7 +443,7 @@ impl<M: Model> Cube<M> {
         self.team().sum(0.0);
         let t = std::time::Instant::now();
         for step in 1..=steps {
-            self.advance();
+            self.advance()?;
             if shuffle_every > 0 && step % shuffle_every == 0 {
                 let t = std::time::Instant::now();
                 self.shuffle()?;

@@ -495,6 +495,9 @@ pub struct CubePlan {
     pub cells: CellPlan,
     /// Local particles of each held cell.
     pub cell_range: Vec<Range<usize>>,
+    /// For each owned cell, the held cells of its 13 half-shell neighbours (`u32::MAX`: none
+    /// held there): where its bonds and non-bonded pairs are found.
+    pub half_shell: Vec<[u32; 13]>,
     pub stages: Vec<Stage>,
 }
 
@@ -557,10 +560,44 @@ pub fn cube_plan(layout: &Layout, plans: &[CellPlan], rank: usize) -> CubePlan {
         n_owned,
         global,
         shift,
+        half_shell: half_shell(plan),
         cells: plan.clone(),
         cell_range,
         stages,
     }
+}
+
+/// The held cells of each owned cell's 13 half-shell neighbours (`u32::MAX`: not held).
+fn half_shell(c: &CellPlan) -> Vec<[u32; 13]> {
+    // The owned box grown by one cell each way holds every cell the half shell reaches.
+    let base = [0, 1, 2].map(|a| c.lo[a] - 1);
+    let ext = [0, 1, 2].map(|a| (c.hi[a] - c.lo[a] + 2) as usize);
+    let slot = |at: [i64; 3]| -> Option<usize> {
+        let mut i = 0;
+        for a in (0..3).rev() {
+            let v = at[a] - base[a];
+            if v < 0 || v >= ext[a] as i64 {
+                return None;
+            }
+            i = i * ext[a] + v as usize;
+        }
+        Some(i)
+    };
+    let mut at_slot: Vec<u32> = vec![u32::MAX; ext.iter().product()];
+    for (k, h) in c.held.iter().enumerate() {
+        let s = slot(h.at).expect("a held cell lies outside the grown box");
+        debug_assert!(at_slot[s] == u32::MAX, "two held cells at {:?}", h.at);
+        at_slot[s] = k as u32;
+    }
+    (0..c.owned_cells)
+        .map(|k| {
+            let at = c.held[k].at;
+            HALF_SHELL.map(|o| {
+                let t = [0, 1, 2].map(|a| at[a] + o[a] as i64);
+                slot(t).map_or(u32::MAX, |s| at_slot[s])
+            })
+        })
+        .collect()
 }
 
 impl CubePlan {
@@ -574,43 +611,14 @@ impl CubePlan {
         partial: bool,
     ) -> BondList<H> {
         let c = &self.cells;
-        // The owned box grown by one cell each way holds every cell the half shell reaches.
-        let base = [0, 1, 2].map(|a| c.lo[a] - 1);
-        let ext = [0, 1, 2].map(|a| (c.hi[a] - c.lo[a] + 2) as usize);
-        let slot = |at: [i64; 3]| -> Option<usize> {
-            let mut i = 0;
-            for a in (0..3).rev() {
-                let v = at[a] - base[a];
-                if v < 0 || v >= ext[a] as i64 {
-                    return None;
-                }
-                i = i * ext[a] + v as usize;
-            }
-            Some(i)
-        };
-        let mut at_slot: Vec<Option<usize>> = vec![None; ext.iter().product()];
-        for (k, h) in c.held.iter().enumerate() {
-            let s = slot(h.at).expect("a held cell lies outside the grown box");
-            debug_assert!(at_slot[s].is_none(), "two held cells at {:?}", h.at);
-            at_slot[s] = Some(k);
-        }
         let h2 = horizon * horizon * (1.0 + 2e-10);
         let mut families = Families::new(x0.len(), horizon, dx, partial);
         let mut found: Vec<(u32, f64)> = Vec::new();
         for k in 0..c.owned_cells {
-            let at = c.held[k].at;
-            let neighbours: Vec<Range<usize>> = HALF_SHELL
+            let neighbours: Vec<Range<usize>> = self.half_shell[k]
                 .iter()
-                .filter_map(|o| {
-                    let t = [
-                        at[0] + o[0] as i64,
-                        at[1] + o[1] as i64,
-                        at[2] + o[2] as i64,
-                    ];
-                    slot(t)
-                        .and_then(|s| at_slot[s])
-                        .map(|q| self.cell_range[q].clone())
-                })
+                .filter(|&&q| q != u32::MAX)
+                .map(|&q| self.cell_range[q as usize].clone())
                 .collect();
             for i in self.cell_range[k].clone() {
                 let xi = x0[i];

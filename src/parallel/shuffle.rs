@@ -63,6 +63,14 @@ impl<M: Model> Cube<M> {
         if !self.someone_left() {
             return Ok(false);
         }
+        self.shuffle_now()?;
+        Ok(true)
+    }
+
+    /// Redraws ownership and ghosts from current positions now, whether or not anyone left
+    /// (a neighbour-list rebuild needs every particle in the cell of its current position).
+    /// Every worker must call it at the same step.
+    pub fn shuffle_now(&mut self) -> Result<(), String> {
         // Everyone gets everything: gather on the root, then the root's concatenation to all.
         let mine = self.pack();
         let mut team = self.team();
@@ -133,7 +141,7 @@ impl<M: Model> Cube<M> {
         self.plan = plan;
         self.layout = layout;
         // Ghosts are refreshed by the next step's exchange; forces came with their particles.
-        Ok(true)
+        Ok(())
     }
 
     /// This procCube's owned particles and bonds as f64 records: counts (particles, bonds,

@@ -183,6 +183,12 @@ impl Snapshot {
     /// evaluation found (call after `Cube::start`).
     pub fn restore_forces<M: Model>(&self, cube: &mut Cube<M>) {
         let lf = <M::Force as Attributes>::LEN;
+        // The restored positions need not lie in the cells the neighbour lists were drawn
+        // from (the layout came from the reference positions): the first step shuffles and
+        // rebuilds. The start's forces are the checkpoint's, restored here.
+        if let Some(pairs) = &mut cube.sim.pairs {
+            pairs.invalidate();
+        }
         let p = &mut cube.sim.particles;
         for i in 0..p.n_owned {
             let g = p.gid[i] as usize;

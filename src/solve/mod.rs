@@ -32,7 +32,7 @@ pub struct Explicit;
 
 impl<M: Model> Solver<M> for Explicit {
     fn advance(&mut self, cube: &mut Cube<M>, _step: u64) -> Result<Option<Relaxed>, String> {
-        cube.advance();
+        cube.advance()?;
         Ok(None)
     }
     fn quasi_static(&self) -> bool {

@@ -85,6 +85,13 @@ impl Converter {
         let output = self.output(deck.output.as_ref(), stem)?;
         let parallel = self.parallel(deck.parallel.as_ref())?;
         let solver = self.solver(deck.solver.as_ref())?;
+        let pair = self.pair(deck.pair.as_ref(), &names)?;
+        if let (Some(p), false) = (&pair, solver.item == super::spec::SolverSpec::Explicit) {
+            return self.err(
+                p.line,
+                "[pair] acts in explicit time stepping only: its neighbour lists follow the particles step by step; remove [solver] or the [pair] section",
+            );
+        }
         // The names of the periodic axes are checked here, after the sections above, as they
         // always have been, so that a deck with several mistakes still reports the same first.
         let periodic = self.periodic(&deck.lattice)?;
@@ -116,6 +123,7 @@ impl Converter {
             output,
             probes,
             solver,
+            pair,
         })
     }
 

@@ -19,6 +19,7 @@ mod convert;
 mod lattice;
 mod model;
 mod output;
+mod pair;
 mod parallel;
 mod sections;
 mod shape;

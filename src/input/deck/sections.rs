@@ -38,6 +38,8 @@ pub(super) struct DeckFile {
     pub(super) parallel: Option<Spanned<ParallelSection>>,
     #[serde(default)]
     pub(super) solver: Option<Spanned<SolverSection>>,
+    #[serde(default)]
+    pub(super) pair: Option<Spanned<PairSection>>,
     /// What `pdq validate` reads (validation/README.md); a run ignores it.
     #[serde(default, rename = "validation")]
     pub(super) _validation: Option<toml::Table>,
@@ -243,4 +245,24 @@ pub(super) struct ProbeSection {
     pub(super) name: String,
     pub(super) at: Position,
     pub(super) stop_beyond: Option<Length>,
+}
+
+/// `[pair]`: a non-bonded pair law beside the bonded model (`pairs/`), its per-material
+/// parameters in `[pair.materials.NAME]` and per-pair ones in `[[pair.between]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct PairSection {
+    pub(super) law: String,
+    pub(super) cutoff: Option<Length>,
+    pub(super) skin: Option<Length>,
+    pub(super) shift: Option<bool>,
+    pub(super) mixing: Option<String>,
+    /// "bonded": leave out pairs joined by an intact bond; "none" (default, but for contact).
+    pub(super) exclude: Option<String>,
+    #[serde(default)]
+    pub(super) materials: BTreeMap<String, Spanned<MaterialSection>>,
+    /// Each table names its two materials in `materials = ["a", "b"]`; every other key is the
+    /// law's.
+    #[serde(default)]
+    pub(super) between: Vec<Spanned<MaterialSection>>,
 }

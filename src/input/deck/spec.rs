@@ -213,6 +213,40 @@ impl ModelLines {
     }
 }
 
+/// `[pair]`: a non-bonded pair law and its parameters, as the law's build reads them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairSpec {
+    pub law: String,
+    pub cutoff: Option<f64>,
+    /// Neighbour-list skin; `None`: 0.3 × the law's cutoff.
+    pub skin: Option<f64>,
+    pub shift: Option<bool>,
+    pub mixing: crate::model::pair::Mixing,
+    /// Leave out pairs joined by an intact bond (the contact law always does).
+    pub exclude_bonded: bool,
+    /// Each material's table, in material order (no keys where the deck gives none).
+    pub own: Vec<Material>,
+    /// `[[pair.between]]` tables: the two materials and the keys.
+    pub between: Vec<(u16, u16, Material)>,
+    /// Where each table's keys are: the materials' then the between tables'.
+    pub lines: Vec<MaterialLines>,
+    /// Line of `[pair]`.
+    pub line: usize,
+}
+
+impl PairSpec {
+    /// The line a pair law's error points at.
+    pub fn line_of(&self, e: &ModelError) -> usize {
+        match e {
+            ModelError::Material { material, .. } => self
+                .lines
+                .get(*material as usize)
+                .map_or(self.line, |m| m.of(e)),
+            ModelError::Model(_) => self.line,
+        }
+    }
+}
+
 /// A deck after checking and unit conversion: everything in the deck's unit system.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
@@ -244,6 +278,8 @@ pub struct Scene {
     pub probes: Vec<ProbeSpec>,
     /// `[solver]`, at line 0 if the deck leaves it out.
     pub solver: Located<SolverSpec>,
+    /// The non-bonded pair law, if the deck has a `[pair]` section.
+    pub pair: Option<PairSpec>,
 }
 
 impl Scene {
@@ -251,6 +287,12 @@ impl Scene {
     /// `[model]`.
     pub fn model_error(&self, e: &ModelError) -> DeckError {
         self.error(Some(self.model_lines.of(e)), format!("[model] {e}"))
+    }
+
+    /// A pair law's error, at the line of the table or key it is about.
+    pub fn pair_error(&self, e: &ModelError) -> DeckError {
+        let line = self.pair.as_ref().map(|p| p.line_of(e));
+        self.error(line, format!("[pair] {e}"))
     }
 
     /// An error located at `line` of this deck.

@@ -13,6 +13,7 @@ use crate::model::attributes::Attributes;
 use crate::model::{Model, ModelBuild, ModelVisitor};
 use std::time::Instant;
 
+mod pairs;
 mod place;
 mod time_step;
 
@@ -66,7 +67,9 @@ pub fn with_model<V: ModelVisitor>(scene: &Scene, visitor: V) -> Result<V::Outpu
 /// the time step, then what the deck places on the particles, and the first forces.
 pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     let start = Instant::now();
-    let (mut particles, cloud_bar, domain, gid_to_index) = particles(&model, scene)?;
+    let pair_pass = pairs::pair_pass(&model, scene)?;
+    let reach = pair_pass.as_ref().map_or(0.0, |p| p.reach());
+    let (mut particles, cloud_bar, domain, gid_to_index) = particles(&model, scene, reach)?;
     let (bonds, correction, bars) = bonds(&model, &mut particles, scene, cloud_bar)?;
     let (dt_critical, dt_critical_particle) = stable_time_step(&model, &particles, &bonds);
     if dt_critical.is_nan() || dt_critical <= 0.0 {
@@ -102,6 +105,9 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         c.set_velocity(&mut sim.particles, 0.0, dt);
     }
     sim.compute_forces();
+    // The pass joins after the bonds' first forces: its lists are built per procCube, from
+    // their cells (`Cube::start`).
+    sim.pairs = pair_pass;
     let seconds = start.elapsed().as_secs_f64();
     sim.timing = crate::engine::timing::Timing::default();
     sim.timing
@@ -131,6 +137,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
 fn particles<M: Model>(
     model: &M,
     scene: &Scene,
+    reach: f64,
 ) -> Result<(Particles<M>, Vec<u32>, Domain, Vec<u32>), DeckError> {
     let ops = scene.geometry_ops();
     let cloud = geometry::build(&scene.lattice, &ops, &scene.geometry_bars()).map_err(|e| {
@@ -144,7 +151,7 @@ fn particles<M: Model>(
             .or(last_subtract);
         scene.error(line, e.message.clone())
     })?;
-    let domain = domain(&cloud.position, scene)?;
+    let domain = domain(&cloud.position, scene, reach)?;
     let (_, _, order) = domain.grid.bin(&cloud.position);
     let gid: Vec<u32> = order.clone();
     let x0 = order.iter().map(|&g| cloud.position[g as usize]).collect();
@@ -264,12 +271,13 @@ fn bar_bonds<M: Model>(
     })
 }
 
-/// Cells of side ≥ the horizon over the scene. A periodic axis spans the lattice box (particle
-/// positions ± half a spacing) exactly, so that its cells tile one period.
-fn domain(points: &[[f64; 3]], scene: &Scene) -> Result<Domain, DeckError> {
+/// Cells of side ≥ the horizon and ≥ the pair law's `reach` (cutoff + skin) over the scene. A
+/// periodic axis spans the lattice box (particle positions ± half a spacing) exactly, so that
+/// its cells tile one period.
+fn domain(points: &[[f64; 3]], scene: &Scene, reach: f64) -> Result<Domain, DeckError> {
     // With shuffling, bonds are found from current cells: the skin keeps a stretched bond
     // between neighbouring cells.
-    let min_cell = scene.horizon * (1.0 + scene.parallel.skin);
+    let min_cell = (scene.horizon * (1.0 + scene.parallel.skin)).max(reach);
     let mut grid = CellGrid::covering(points, min_cell);
     let mut period = [0.0; 3];
     for a in 0..3 {

@@ -1,0 +1,281 @@
+//! The non-bonded pass: pairs of particles within a pair law's cutoff, found from current
+//! positions, beside the bond passes (thesis §2.2, §3.10: Verlet lists with a skin).
+//!
+//! A half neighbour list (each pair once, from its owned end) holds every pair closer than
+//! cutoff + skin when it is built; it stays valid until some particle has moved more than half
+//! the skin since (Fincham & Ralston 1981), when the procCube rebuilds it. The list is built
+//! from the procCube's cells: each owned cell with itself and its 13 half-shell neighbours,
+//! owned or ghost, exactly as bonds are found, so that a pair across a procCube face is found
+//! once, on one side. Forces on ghosts go home with the bonds' force return. Buffers keep
+//! their capacity from build to build: after the first builds, a step allocates nothing.
+
+use crate::engine::bonds::BondList;
+use crate::engine::particles::Particles;
+use crate::model::attributes::Attributes;
+use crate::model::pair::PairLaw;
+use crate::model::Model;
+use std::ops::Range;
+
+/// Where a list build finds the pairs: the particles of each held cell (owned cells first)
+/// and, for each owned cell, the held cells of its 13 half-shell neighbours (`u32::MAX`: none).
+pub struct CellPairs<'a> {
+    pub cell_range: &'a [Range<usize>],
+    pub half_shell: &'a [[u32; 13]],
+}
+
+/// What the last evaluation summed over this procCube's pairs.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairTally {
+    pub energy: f64,
+    /// Σ r·F over pairs (the pairs' part of the virial; pressure P = (2 KE + W)/(3V)).
+    pub virial: f64,
+    /// Pairs within their cutoff.
+    pub pairs: u64,
+}
+
+/// The non-bonded forces of a run, whatever its law: one boxed value per procCube, called once
+/// per step (no dispatch per pair).
+pub trait NonBonded<M: Model>: Send {
+    /// Adds every listed pair's force to both ends (ghost ends included).
+    fn add_forces(&mut self, p: &mut Particles<M>);
+    /// Whether some owned particle moved more than half the skin since the last build.
+    fn moved_too_far(&self, p: &Particles<M>) -> bool;
+    /// Rebuilds the list from the current positions.
+    fn rebuild(&mut self, p: &Particles<M>, cells: &CellPairs, bonds: &BondList<M::Bond>);
+    /// Cutoff + skin: the cells must be at least this wide.
+    fn reach(&self) -> f64;
+    fn tally(&self) -> PairTally;
+    /// Builds so far.
+    fn builds(&self) -> u64;
+    fn law(&self) -> &'static str;
+    /// A copy with an empty list (one per procCube).
+    fn fresh(&self) -> Box<dyn NonBonded<M>>;
+    /// Forgets where particles were at the last build, so that the next step rebuilds (after a
+    /// restart put them elsewhere).
+    fn invalidate(&mut self);
+}
+
+/// A half neighbour list with its skin, and the law it is evaluated with.
+pub struct PairPass<L: PairLaw> {
+    law: L,
+    skin: f64,
+    /// Leave out pairs joined by an intact bond (contact; the membrane's WCA).
+    skip_bonded: bool,
+    offsets: Vec<u32>,
+    partner: Vec<u32>,
+    /// Owned positions at the last build.
+    at_build: Vec<[f64; 3]>,
+    /// Scratch of the build: bond partners of each particle, both ways.
+    bonded_start: Vec<u32>,
+    bonded: Vec<u32>,
+    mark: Vec<u32>,
+    tally: PairTally,
+    builds: u64,
+    /// The material of every particle at the last build, if there is only one.
+    single: Option<u16>,
+}
+
+impl<L: PairLaw> PairPass<L> {
+    pub fn new(law: L, skin: f64, exclude_bonded: bool) -> Self {
+        PairPass {
+            skip_bonded: exclude_bonded || L::SKIPS_BONDED,
+            law,
+            skin,
+            offsets: vec![0],
+            partner: Vec::new(),
+            at_build: Vec::new(),
+            bonded_start: Vec::new(),
+            bonded: Vec::new(),
+            mark: Vec::new(),
+            tally: PairTally::default(),
+            builds: 0,
+            single: None,
+        }
+    }
+
+    /// Listed partners of owned particle `i`.
+    pub fn partners(&self, i: usize) -> &[u32] {
+        &self.partner[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+
+    /// Every intact bond's two ends, as lists per particle (owned and ghost).
+    fn index_bonds<H: Attributes>(&mut self, n: usize, bonds: &BondList<H>) {
+        self.bonded_start.clear();
+        self.bonded_start.resize(n + 1, 0);
+        for (i, j, k) in bonds.iter() {
+            if !bonds.broken[k] {
+                self.bonded_start[i + 1] += 1;
+                self.bonded_start[j + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            self.bonded_start[i + 1] += self.bonded_start[i];
+        }
+        self.bonded.clear();
+        self.bonded.resize(self.bonded_start[n] as usize, 0);
+        // `mark` doubles as the fill cursor here; it is reset below.
+        self.mark.clear();
+        self.mark.extend_from_slice(&self.bonded_start[..n]);
+        for (i, j, k) in bonds.iter() {
+            if !bonds.broken[k] {
+                self.bonded[self.mark[i] as usize] = j as u32;
+                self.mark[i] += 1;
+                self.bonded[self.mark[j] as usize] = i as u32;
+                self.mark[j] += 1;
+            }
+        }
+        self.mark.iter_mut().for_each(|m| *m = u32::MAX);
+    }
+}
+
+#[inline(always)]
+fn pos<M: Model>(p: &Particles<M>, i: usize) -> [f64; 3] {
+    let a = p.alter[i].as_slice();
+    [a[0], a[1], a[2]]
+}
+
+impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
+    fn add_forces(&mut self, p: &mut Particles<M>) {
+        assert_eq!(
+            self.offsets.len(),
+            p.n_owned + 1,
+            "the neighbour list was not built for these particles"
+        );
+        let single = self.single;
+        let mut t = PairTally::default();
+        for i in 0..p.n_owned {
+            let xi = pos(p, i);
+            let mi = p.material[i];
+            let mut fi = [0.0; 3];
+            for &j in &self.partner[self.offsets[i] as usize..self.offsets[i + 1] as usize] {
+                let j = j as usize;
+                let xj = pos(p, j);
+                let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
+                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                let c = match single {
+                    Some(m) => self.law.coeff(m, m),
+                    None => self.law.coeff(mi, p.material[j]),
+                };
+                let vv = if L::VOLUMES {
+                    p.volume[i] * p.volume[j]
+                } else {
+                    1.0
+                };
+                let Some((fr, u)) = self.law.eval(&c, r2, vv) else {
+                    continue;
+                };
+                let f = [fr * d[0], fr * d[1], fr * d[2]];
+                let fj = p.force[j].as_mut_slice();
+                for k in 0..3 {
+                    fi[k] -= f[k];
+                    fj[k] += f[k];
+                }
+                t.energy += u;
+                t.virial += fr * r2;
+                t.pairs += 1;
+            }
+            let f = p.force[i].as_mut_slice();
+            for k in 0..3 {
+                f[k] += fi[k];
+            }
+        }
+        self.tally = t;
+    }
+
+    fn moved_too_far(&self, p: &Particles<M>) -> bool {
+        if self.at_build.len() != p.n_owned {
+            return true;
+        }
+        let limit = 0.25 * self.skin * self.skin;
+        (0..p.n_owned).any(|i| {
+            let (a, b) = (pos(p, i), self.at_build[i]);
+            let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > limit
+        })
+    }
+
+    fn rebuild(&mut self, p: &Particles<M>, cells: &CellPairs, bonds: &BondList<M::Bond>) {
+        let n = p.len();
+        if self.skip_bonded {
+            self.index_bonds(n, bonds);
+        }
+        let reach = <Self as NonBonded<M>>::reach(self);
+        let r2max = reach * reach;
+        self.single = single_material(&p.material);
+        let PairPass {
+            offsets,
+            partner,
+            mark,
+            bonded_start,
+            bonded,
+            skip_bonded,
+            ..
+        } = self;
+        let skip = *skip_bonded;
+        offsets.clear();
+        offsets.resize(p.n_owned + 1, 0);
+        partner.clear();
+        for (k, shell) in cells.half_shell.iter().enumerate() {
+            let own = cells.cell_range[k].clone();
+            for i in own.clone() {
+                let xi = pos(p, i);
+                if skip {
+                    let s = bonded_start[i] as usize..bonded_start[i + 1] as usize;
+                    for &j in &bonded[s] {
+                        mark[j as usize] = i as u32;
+                    }
+                }
+                let mut visit = |j: usize| {
+                    let xj = pos(p, j);
+                    let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
+                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    if r2 < r2max && !(skip && mark[j] == i as u32) {
+                        partner.push(j as u32);
+                    }
+                };
+                for j in i + 1..own.end {
+                    visit(j);
+                }
+                for &q in shell.iter().filter(|&&q| q != u32::MAX) {
+                    for j in cells.cell_range[q as usize].clone() {
+                        visit(j);
+                    }
+                }
+                offsets[i + 1] = partner.len() as u32;
+            }
+        }
+        self.at_build.clear();
+        self.at_build.extend((0..p.n_owned).map(|i| pos(p, i)));
+        self.builds += 1;
+    }
+
+    fn reach(&self) -> f64 {
+        self.law.cutoff() + self.skin
+    }
+
+    fn tally(&self) -> PairTally {
+        self.tally
+    }
+
+    fn builds(&self) -> u64 {
+        self.builds
+    }
+
+    fn law(&self) -> &'static str {
+        L::NAME
+    }
+
+    fn invalidate(&mut self) {
+        self.at_build.clear();
+    }
+
+    fn fresh(&self) -> Box<dyn NonBonded<M>> {
+        Box::new(PairPass::new(self.law.clone(), self.skin, self.skip_bonded))
+    }
+}
+
+/// The material of every particle, if there is only one.
+fn single_material(material: &[u16]) -> Option<u16> {
+    let first = *material.first()?;
+    material.iter().all(|&m| m == first).then_some(first)
+}
