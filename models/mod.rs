@@ -7,6 +7,7 @@ pub mod concrete;
 pub mod lps;
 pub mod micropolar;
 pub mod pmb;
+pub mod point;
 pub mod thermal;
 
 crate::model_registry! {
@@ -15,4 +16,5 @@ crate::model_registry! {
     lps::Lps,
     micropolar::Micropolar,
     thermal::Thermal,
+    point::Point,
 }
