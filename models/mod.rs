@@ -5,6 +5,7 @@
 
 pub mod concrete;
 pub mod lps;
+pub mod membrane;
 pub mod micropolar;
 pub mod pmb;
 pub mod point;
@@ -17,4 +18,5 @@ crate::model_registry! {
     micropolar::Micropolar,
     thermal::Thermal,
     point::Point,
+    membrane::Membrane,
 }
