@@ -5,8 +5,10 @@
 
 pub mod concrete;
 pub mod lps;
+pub mod membrane;
 pub mod micropolar;
 pub mod pmb;
+pub mod point;
 pub mod thermal;
 
 crate::model_registry! {
@@ -15,4 +17,6 @@ crate::model_registry! {
     lps::Lps,
     micropolar::Micropolar,
     thermal::Thermal,
+    point::Point,
+    membrane::Membrane,
 }

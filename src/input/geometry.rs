@@ -1,8 +1,15 @@
-//! Reference particle cloud of a scene: shapes filled on a simple-cubic lattice, plus bars.
+//! Reference particle cloud of a scene: shapes filled on a simple-cubic, face-centred or
+//! body-centred cubic lattice, plus bars.
 //!
 //! Overlap and boundary rules (user-visible, keep the docs in sync):
-//! - Sites sit at cell centres (`origin + spacing·(i + ½)`), so a face on a lattice plane never
-//!   touches a site and a box `[0, L]` holds exactly `L / spacing` sites per axis.
+//! - Simple cubic: sites sit at cell centres (`origin + spacing·(i + ½)`), so a face on a
+//!   lattice plane never touches a site and a box `[0, L]` holds exactly `L / spacing` sites per
+//!   axis.
+//! - fcc and bcc: sites sit at `origin + a·(i + b)` for the basis offsets b (fcc (0,0,0),
+//!   (½,½,0), (½,0,½), (0,½,½); bcc (0,0,0), (½,½,½)), as in LAMMPS, so they lie on the lattice
+//!   planes. A box fills them half-open, `min <= p < max` per axis, like LAMMPS's
+//!   `create_atoms` in a block: a box of n whole cells holds n³·basis sites, and such boxes
+//!   tile, side by side and across a periodic boundary. Other shapes stay closed.
 //! - Box, Cylinder, Sphere and Prism are closed (a point on the surface is inside); Slab is
 //!   half-open `from <= p < to`. `build` widens every test by `1e-9·spacing` (Slab: shifts both
 //!   ends down by it) so a site lying on a face up to rounding gets the same answer however its
@@ -116,6 +123,18 @@ impl Shape {
     /// Exact test (no tolerance); see the module doc for which boundaries are inside.
     pub fn contains(&self, p: Vec3) -> bool {
         self.contains_tol(p, 0.0)
+    }
+
+    /// How `build` fills lattice sites: boxes half-open (`min <= p < max`) on fcc and bcc
+    /// lattices, whose sites lie on the planes box faces are usually put on; otherwise
+    /// `contains_tol`.
+    fn fills(&self, p: Vec3, tol: f64, half_open: bool) -> bool {
+        match self {
+            Shape::Box { min, max } if half_open => {
+                (0..3).all(|e| p[e] >= min[e] - tol && p[e] < max[e] - tol)
+            }
+            _ => self.contains_tol(p, tol),
+        }
     }
 
     fn contains_tol(&self, p: Vec3, tol: f64) -> bool {
@@ -283,9 +302,63 @@ impl Shape {
     }
 }
 
-/// Simple-cubic lattice: sites at origin + spacing·(i + ½, j + ½, k + ½) for integers i, j, k, so a box [0, 200] with spacing 1 holds exactly 200 sites along that axis (site = centre of a cube of side `spacing`, volume spacing³) and box faces never cut through sites.
+/// The cubic lattices a scene can be filled on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum LatticeKind {
+    /// One site per cell, at its centre.
+    #[default]
+    Sc,
+    /// Face-centred cubic: four sites per cell, nearest neighbours a/√2 apart (12 of them).
+    Fcc,
+    /// Body-centred cubic: two sites per cell, nearest neighbours a√3/2 apart (8 of them).
+    Bcc,
+}
+
+impl LatticeKind {
+    /// The deck's word for it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            LatticeKind::Sc => "sc",
+            LatticeKind::Fcc => "fcc",
+            LatticeKind::Bcc => "bcc",
+        }
+    }
+
+    /// Sites per cubic cell.
+    pub fn basis(&self) -> usize {
+        match self {
+            LatticeKind::Sc => 1,
+            LatticeKind::Fcc => 4,
+            LatticeKind::Bcc => 2,
+        }
+    }
+
+    /// The cubic cell side a of `density` sites per unit volume: a³ = basis / density.
+    pub fn cell_side(&self, density: f64) -> f64 {
+        (self.basis() as f64 / density).cbrt()
+    }
+
+    /// Whether a key is a site. fcc and bcc keys count half cells (the basis offsets are
+    /// halves): fcc sites are the keys with an even sum, bcc those with three even or three odd
+    /// indices.
+    fn admits(&self, key: &Key) -> bool {
+        match self {
+            LatticeKind::Sc => true,
+            LatticeKind::Fcc => (key[0] + key[1] + key[2]).rem_euclid(2) == 0,
+            LatticeKind::Bcc => {
+                key[0].rem_euclid(2) == key[1].rem_euclid(2)
+                    && key[1].rem_euclid(2) == key[2].rem_euclid(2)
+            }
+        }
+    }
+}
+
+/// A cubic lattice of cell side `spacing` (a). Simple cubic: sites at origin + spacing·(i + ½, j + ½, k + ½) for integers i, j, k, so a box [0, 200] with spacing 1 holds exactly 200 sites along that axis (site = centre of a cube of side `spacing`, volume spacing³) and box faces never cut through sites. fcc and bcc: sites at origin + spacing·(i + b) for each basis offset b, volume spacing³ / basis each (see the module doc for how a box fills them).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lattice {
+    pub kind: LatticeKind,
+    /// The cubic cell side a (for sc the distance between neighbours); horizons given as
+    /// `m` spacings are m·a whatever the kind.
     pub spacing: f64,
     pub origin: Vec3,
     /// Each lattice site is moved by a random offset of up to `jitter × spacing` per axis
@@ -298,11 +371,18 @@ pub struct Lattice {
 impl Lattice {
     pub fn regular(spacing: f64, origin: Vec3) -> Self {
         Lattice {
+            kind: LatticeKind::Sc,
             spacing,
             origin,
             jitter: 0.0,
             seed: 0,
         }
+    }
+
+    /// The volume of each lattice particle: a³ / basis.
+    pub fn site_volume(&self) -> f64 {
+        let s = self.spacing;
+        s * s * s / self.kind.basis() as f64
     }
 
     /// The offset of site `key`: uniform in [−jitter·spacing, jitter·spacing) per axis, a
@@ -489,12 +569,21 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
         )));
     }
     let tol = 1e-9 * s;
-    let site = |key: &Key| [0, 1, 2].map(|e| o[e] + s * (key[2 - e] as f64 + 0.5));
+    let kind = lattice.kind;
+    let half_open = kind != LatticeKind::Sc;
+    // Keys count whole cells on the simple-cubic lattice (sites at their centres) and half
+    // cells on fcc and bcc (sites on the planes), where `admits` picks the sites.
+    let (step, shift) = match kind {
+        LatticeKind::Sc => (s, 0.5),
+        LatticeKind::Fcc | LatticeKind::Bcc => (0.5 * s, 0.0),
+    };
+    let site = |key: &Key| [0, 1, 2].map(|e| o[e] + step * (key[2 - e] as f64 + shift));
     // Index ranges (padded by one) of the sites covering [lo, hi]; inside tests trim them.
     let range = |lo: Vec3, hi: Vec3| {
-        let idx = |x: f64, e: usize| (x - o[e]) / s - 0.5;
+        let idx = |x: f64, e: usize| (x - o[e]) / step - shift;
         [0, 1, 2].map(|e| (idx(lo[e], e).floor() - 1.0, idx(hi[e], e).ceil() + 1.0))
     };
+    let sites = |r| sites(r).filter(move |key| kind.admits(key));
     let mut filled: BTreeMap<Key, u16> = BTreeMap::new();
     for (n, op) in ops.iter().enumerate() {
         let (Op::Add { shape, .. } | Op::Subtract { shape }) = op;
@@ -506,7 +595,7 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
         };
         shape.validate().map_err(|m| err(&format!(": {m}")))?;
         let Op::Add { material, .. } = op else {
-            filled.retain(|key, _| !shape.contains_tol(site(key), tol));
+            filled.retain(|key, _| !shape.fills(site(key), tol, half_open));
             continue;
         };
         let (lo, hi) = shape.bounds();
@@ -520,7 +609,7 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
             return Err(err(" spans more than u32::MAX lattice sites"));
         }
         let mut selected = 0usize;
-        for key in sites(r).filter(|key| shape.contains_tol(site(key), tol)) {
+        for key in sites(r).filter(|key| shape.fills(site(key), tol, half_open)) {
             filled.insert(key, *material);
             selected += 1;
         }
@@ -569,7 +658,7 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
         let (p, d) = (site(key), lattice.offset(key));
         (
             [p[0] + d[0], p[1] + d[1], p[2] + d[2]],
-            s * s * s,
+            lattice.site_volume(),
             m,
             s,
             NOT_A_BAR,

@@ -278,3 +278,79 @@ fn errors() {
     let e = run(1.0, &[add(cube(0.0, 1e9), 1)], &[]).unwrap_err();
     assert!(e.message.contains("u32::MAX"), "{e}");
 }
+
+fn cubic(kind: LatticeKind, a: f64) -> Lattice {
+    Lattice {
+        kind,
+        ..Lattice::regular(a, [0.0; 3])
+    }
+}
+
+#[test]
+fn fcc_and_bcc_boxes_of_whole_cells_hold_basis_sites_per_cell() {
+    // LAMMPS in.lj: `lattice fcc 0.8442`, `region box block 0 20 0 20 0 20` → 32,000 atoms.
+    let a = LatticeKind::Fcc.cell_side(0.8442);
+    assert!((a - 1.6796).abs() < 1e-4, "{a}");
+    let fcc = cubic(LatticeKind::Fcc, a);
+    let cloud = build(&fcc, &[add(cube(0.0, 20.0 * a), 0)], &[]).unwrap();
+    assert_eq!(cloud.len(), 32_000);
+    // Half-open: the max faces hold sites of the next cells, which are left out.
+    let top = 20.0 * a * (1.0 - 1e-12);
+    assert!(cloud.position.iter().all(|p| p.iter().all(|&x| x < top)));
+    assert!(cloud.volume.iter().all(|&v| v == a * a * a / 4.0));
+    let total: f64 = cloud.volume.iter().sum();
+    assert!((total - (20.0 * a).powi(3)).abs() < 1e-9 * total);
+    let bcc = cubic(LatticeKind::Bcc, 2.0);
+    let cloud = build(&bcc, &[add(cube(0.0, 6.0), 0)], &[]).unwrap();
+    assert_eq!(cloud.len(), 2 * 27);
+    assert!(cloud.position.contains(&[1.0, 1.0, 1.0]) && cloud.position.contains(&[0.0; 3]));
+    assert!(!cloud.position.contains(&[1.0, 0.0, 0.0]));
+    // Two boxes side by side tile: no site twice, none lost.
+    let halves = [
+        add(bx([0.0; 3], [3.0 * a, 6.0 * a, 6.0 * a]), 0),
+        add(bx([3.0 * a, 0.0, 0.0], [6.0 * a; 3]), 1),
+    ];
+    assert_eq!(build(&fcc, &halves, &[]).unwrap().len(), 4 * 216);
+}
+
+#[test]
+fn fcc_sites_have_twelve_neighbours_and_bcc_eight() {
+    for (kind, near, count) in [
+        (LatticeKind::Fcc, 0.5f64.sqrt(), 12),
+        (LatticeKind::Bcc, 0.75f64.sqrt(), 8),
+        (LatticeKind::Sc, 1.0, 6),
+    ] {
+        let cloud = build(&cubic(kind, 1.0), &[add(cube(0.0, 5.0), 0)], &[]).unwrap();
+        let centre = cloud
+            .position
+            .iter()
+            .min_by(|p, q| {
+                let d = |p: &Vec3| p.iter().map(|x| (x - 2.5).powi(2)).sum::<f64>();
+                d(p).total_cmp(&d(q))
+            })
+            .unwrap();
+        let mut d: Vec<f64> = cloud
+            .position
+            .iter()
+            .map(|p| sub(*p, *centre))
+            .map(|v| dot(v, v).sqrt())
+            .filter(|&r| r > 0.0)
+            .collect();
+        d.sort_by(f64::total_cmp);
+        assert!((d[0] - near).abs() < 1e-12, "{kind:?}: {}", d[0]);
+        assert_eq!(
+            d.iter().filter(|&&r| r < near + 1e-9).count(),
+            count,
+            "{kind:?}"
+        );
+    }
+}
+
+#[test]
+fn simple_cubic_is_unchanged_by_the_lattice_kinds() {
+    // Closed box on sc: a site on the max face (here 2.5) is still in.
+    let cloud = run(1.0, &[add(bx([0.0; 3], [2.5, 2.0, 2.0]), 0)], &[]).unwrap();
+    assert_eq!(cloud.len(), 3 * 2 * 2);
+    assert_eq!(cloud.position[0], [0.5, 0.5, 0.5]);
+    assert_eq!(cloud.volume[0], 1.0);
+}

@@ -53,7 +53,8 @@ const KNOWN: &[(Dim, &str, &str)] = &[
     (STRESS, "stress", "25 GPa"), (FORCE, "force", "10 kN"),
     (Dim::new(1, -2, -2), "force per volume", "1 lbf/in^3"),
     (Dim::new(1, 0, -2), "energy per area", "1 lbf*in/in^2"),
-    (Dim::new(1, -5, -2), "micromodulus", "1e20 N/m^6"), (Dim::new(0, 0, 0), "dimensionless", "0.5"),
+    (Dim::new(1, -5, -2), "micromodulus", "1e20 N/m^6"), (Dim::new(0, -3, 0), "number density", "8.5e28 m^-3"),
+    (Dim::new(0, 0, 0), "dimensionless", "0.5"),
 ];
 
 impl Dim {
@@ -121,7 +122,16 @@ pub enum UnitSystem {
     InchPoundSecond,
     /// mm, N, s; the coherent mass unit is then the tonne (N·s²/mm).
     MmNewtonSecond,
+    /// Lennard-Jones reduced units: lengths in σ, energies in ε, masses in m, times in
+    /// τ = σ√(m/ε), temperatures in ε/k_B (k_B = 1). They have no fixed size in SI (σ, ε and m
+    /// are the substance's), so a deck in them takes plain numbers only: a string with a unit
+    /// is refused where the deck is read (`input/deck/plain.rs`, and [`crate::model::Units`]
+    /// for material keys).
+    Lj,
 }
+
+/// Boltzmann's constant in J/K (exact since the 2019 SI).
+const BOLTZMANN_SI: f64 = 1.380_649e-23;
 
 impl UnitSystem {
     pub fn from_name(name: &str) -> Result<Self, String> {
@@ -129,9 +139,11 @@ impl UnitSystem {
             "SI" | "si" | "m-kg-s" => Ok(UnitSystem::Si),
             "in-lbf-s" | "inch" | "US" => Ok(UnitSystem::InchPoundSecond),
             "mm-N-s" => Ok(UnitSystem::MmNewtonSecond),
+            "lj" | "LJ" => Ok(UnitSystem::Lj),
             other => Err(format!(
                 "unknown unit system \"{other}\"; accepted: \"SI\", \"si\", \"m-kg-s\" \
-                 (m, kg, s), \"in-lbf-s\", \"inch\", \"US\" (in, lbf, s), \"mm-N-s\" (mm, N, s)"
+                 (m, kg, s), \"in-lbf-s\", \"inch\", \"US\" (in, lbf, s), \"mm-N-s\" (mm, N, s), \
+                 \"lj\" (Lennard-Jones reduced units: σ, ε, m, τ; plain numbers only)"
             )),
         }
     }
@@ -141,20 +153,36 @@ impl UnitSystem {
             UnitSystem::Si => "SI",
             UnitSystem::InchPoundSecond => "in-lbf-s",
             UnitSystem::MmNewtonSecond => "mm-N-s",
+            UnitSystem::Lj => "lj",
         }
     }
 
-    /// (length unit in m, force unit in N, length label, force label).
+    /// Boltzmann's constant k_B in this system's energy unit per kelvin (per reduced
+    /// temperature unit ε/k_B in `lj`, where it is 1 by definition): SI 1.380649e-23 J/K,
+    /// in-lbf-s 1.380649e-23 / (4.448… · 0.0254) lbf·in/K, mm-N-s 1.380649e-20 N·mm/K. The
+    /// dimensional systems all measure temperature in kelvin; none of them has a unit of its own
+    /// for it.
+    pub fn boltzmann(&self) -> f64 {
+        match self {
+            UnitSystem::Lj => 1.0,
+            _ => BOLTZMANN_SI / self.si_factor(ENERGY),
+        }
+    }
+
+    /// (length unit in m, force unit in N, length label, force label). `lj` has none: its
+    /// quantities are never converted (plain numbers only); NaN marks the size as unknown.
     fn base(&self) -> (f64, f64, &'static str, &'static str) {
         match self {
             UnitSystem::Si => (1.0, 1.0, "m", "N"),
             UnitSystem::InchPoundSecond => (INCH, LBF, "in", "lbf"),
             UnitSystem::MmNewtonSecond => (1e-3, 1.0, "mm", "N"),
+            UnitSystem::Lj => (f64::NAN, f64::NAN, "σ", "ε/σ"),
         }
     }
 
     /// The mass unit is derived (force·s²/length) rather than chosen, which is
-    /// what makes in-lbf-s and mm-N-s coherent. The time unit is always 1 s.
+    /// what makes in-lbf-s and mm-N-s coherent. The time unit is always 1 s. In `lj`, where a
+    /// unit has no size in SI, every factor is NaN (only a dimensionless one is 1).
     pub fn si_factor(&self, dim: Dim) -> f64 {
         let (len, force, _, _) = self.base();
         (force / len).powi(dim.m.into()) * len.powi(dim.l.into())
@@ -164,6 +192,9 @@ impl UnitSystem {
     /// a label read back with a number parses to this system's unit.
     pub fn label(&self, dim: Dim) -> String {
         use UnitSystem::*;
+        if *self == Lj {
+            return lj_label(dim);
+        }
         let named = match (self, (dim.m, dim.l, dim.t)) {
             (_, (0, 0, 0)) => "1",
             (Si, (1, 0, 0)) => "kg",
@@ -187,15 +218,47 @@ impl UnitSystem {
             .filter(|p| p.1 > 0)
             .map(|p| power(p.0, p.1))
             .collect();
-        let mut out = if num.is_empty() {
-            "1".to_string()
-        } else {
-            num.join("*")
-        };
-        for p in parts.iter().filter(|p| p.1 < 0) {
+        let den = parts.iter().filter(|p| p.1 < 0);
+        if num.is_empty() {
+            // "m^-3", not "1/m^3": the unit grammar reads a name first.
+            return den.map(|p| power(p.0, p.1)).collect::<Vec<_>>().join("*");
+        }
+        let mut out = num.join("*");
+        for p in den {
             out += &format!("/{}", power(p.0, -p.1));
         }
         out
+    }
+}
+
+/// An `lj` unit as m^a σ^b τ^c ("1" for a number): a label to read, not to parse, as lj decks
+/// take no units.
+fn lj_label(dim: Dim) -> String {
+    let parts = [("m", dim.m), ("σ", dim.l), ("τ", dim.t)];
+    let used: Vec<String> = parts
+        .iter()
+        .filter(|p| p.1 != 0)
+        .map(|p| power(p.0, p.1.into()))
+        .collect();
+    if used.is_empty() {
+        "1".to_string()
+    } else {
+        used.join("*")
+    }
+}
+
+/// Whether a deck string is a quantity written with a unit: one number or three, then a unit
+/// expression ("3 mm", "3mm", "1 2 3 in"). A name that happens to start with a digit
+/// ("1st_support", "3D block") is not one: what follows its number is no unit.
+pub fn written_with_unit(s: &str) -> bool {
+    let toks: Vec<&str> = s.split_whitespace().collect();
+    let numbers = toks.iter().take_while(|t| t.parse::<f64>().is_ok()).count();
+    if numbers > 0 && numbers < toks.len() {
+        return parse_unit(&toks[numbers..].join(" "), s).is_ok();
+    }
+    match split_number(s.trim()) {
+        Some((_, rest)) if !rest.trim().is_empty() => parse_unit(rest.trim(), s).is_ok(),
+        _ => false,
     }
 }
 
@@ -368,6 +431,13 @@ fn parse_as(s: &str, dim: Dim) -> Result<Repr, String> {
 impl crate::model::Units for UnitSystem {
     fn value(&self, written: &Written, dim: Dimension) -> Result<f64, String> {
         let dim = Dim::new(dim.mass, dim.length, dim.time);
+        if let (UnitSystem::Lj, Written::Text(s)) = (self, written) {
+            if written_with_unit(s) {
+                return Err(format!(
+                    "\"{s}\" has a unit, but a deck in units = \"lj\" takes plain numbers (in σ, ε, m, τ)"
+                ));
+            }
+        }
         let repr = match written {
             Written::Number(v) => Repr::Plain(*v),
             Written::Text(s) => parse_as(s, dim)?,
@@ -394,6 +464,7 @@ impl UnitSystem {
             UnitSystem::Si => &UnitSystem::Si,
             UnitSystem::InchPoundSecond => &UnitSystem::InchPoundSecond,
             UnitSystem::MmNewtonSecond => &UnitSystem::MmNewtonSecond,
+            UnitSystem::Lj => &UnitSystem::Lj,
         }
     }
 }
@@ -504,6 +575,8 @@ pub type Velocity = Quantity<0, 1, -1>;
 pub type Acceleration = Quantity<0, 1, -2>;
 pub type Mass = Quantity<1, 0, 0>;
 pub type Density = Quantity<1, -3, 0>;
+/// Particles per unit volume (`[lattice] density`).
+pub type NumberDensity = Quantity<0, -3, 0>;
 pub type Stress = Quantity<1, -1, -2>;
 pub type Force = Quantity<1, 1, -2>;
 /// Force per volume (body force).
@@ -518,144 +591,5 @@ pub type ForceVector = Vector<1, 1, -2>;
 pub type AccelerationVector = Vector<0, 1, -2>;
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use serde::Deserialize;
-    use UnitSystem::{InchPoundSecond as Ips, MmNewtonSecond as Mm, Si};
-
-    fn close(a: f64, b: f64, rel: f64) {
-        assert!((a - b).abs() <= rel * b.abs(), "{a} != {b}");
-    }
-
-    #[test]
-    fn conversions() {
-        #[rustfmt::skip]
-        let cases = [
-            ("3605 ksi", Stress::DIM, Ips, 3.605e6, 1e-12),
-            ("4000 psi", Stress::DIM, Ips, 4000.0, 1e-12),
-            ("25 GPa", Stress::DIM, Si, 2.5e10, 1e-12),
-            ("25 GPa", Stress::DIM, Ips, 25e9 / 6894.757293168361, 1e-12),
-            ("25 GPa", Stress::DIM, Mm, 25e3, 1e-12),
-            ("145 lb/ft^3", Density::DIM, Ips, 2.1735e-4, 1e-4),
-            ("145 lb/ft^3", Density::DIM, Ips, 145.0 / 1728.0 / 386.09, 1e-12),
-            ("2400 kg/m^3", Density::DIM, Si, 2400.0, 1e-12),
-            ("2400 kg/m^3", Density::DIM, Mm, 2.4e-9, 1e-12),
-            ("3 in", Length::DIM, Si, 0.0762, 1e-12),
-            ("5 µm", Length::DIM, Si, 5e-6, 1e-12),
-            ("7.87 in/s", Velocity::DIM, Si, 7.87 * 0.0254, 1e-12),
-            ("7.87in/s", Velocity::DIM, Ips, 7.87, 1e-12),
-            ("1.0 lbf*in/in^2", EnergyPerArea::DIM, Ips, 1.0, 1e-12),
-            ("1.0 lbf * in / in ** 2", EnergyPerArea::DIM, Ips, 1.0, 1e-12),
-            ("1e-7 s", Time::DIM, Si, 1e-7, 1e-12),
-            ("-1.5e3 N", Force::DIM, Si, -1500.0, 1e-12),
-            ("2 kips", Force::DIM, Ips, 2000.0, 1e-12),
-            ("9.81 m/s^2", Acceleration::DIM, Si, 9.81, 1e-12),
-            ("1 N/m^6", Micromodulus::DIM, Si, 1.0, 1e-12),
-            ("1 N·m", Dim::new(1, 2, -2), Si, 1.0, 1e-12),
-        ];
-        for (text, dim, sys, want, rel) in cases {
-            let (v, d) = parse_quantity(text).unwrap();
-            assert_eq!(d, dim, "{text}");
-            close(v / sys.si_factor(d), want, rel);
-        }
-        assert_eq!(Micromodulus::DIM.describe(), "micromodulus (M L^-5 T^-2)");
-        assert_eq!(Dim::new(0, 0, 0).describe(), "dimensionless");
-        assert_eq!(Dim::new(2, 1, 0).describe(), "M^2 L");
-        assert!(parse_quantity("3").unwrap_err().contains("no unit"));
-        for bad in ["in", "3 in^", "3 in/", "3 in+s", "3 in^999", "3 in 2"] {
-            assert!(parse_quantity(bad).is_err(), "{bad}");
-        }
-    }
-
-    #[test]
-    fn systems_and_labels() {
-        assert_eq!(UnitSystem::from_name("US"), Ok(Ips));
-        assert_eq!(UnitSystem::from_name("m-kg-s").map(|s| s.name()), Ok("SI"));
-        assert!(UnitSystem::from_name("cgs").unwrap_err().contains("mm-N-s"));
-        close(Mm.si_factor(MASS), 1000.0, 1e-12);
-        close(Ips.si_factor(Density::DIM), LBF / INCH.powi(4), 1e-12);
-        assert_eq!(Ips.label(Density::DIM), "lbf*s^2/in^4");
-        assert_eq!(Ips.label(STRESS), "psi");
-        assert_eq!(Si.label(Micromodulus::DIM), "N/m^6");
-        // Every label of a named dimension parses back to that system's unit.
-        for sys in [Si, Ips, Mm] {
-            for &(dim, _, _) in &KNOWN[..KNOWN.len() - 1] {
-                let (v, d) = parse_quantity(&format!("1 {}", sys.label(dim))).unwrap();
-                assert_eq!(d, dim, "{}", sys.label(dim));
-                close(v, sys.si_factor(dim), 1e-12);
-            }
-        }
-    }
-
-    #[test]
-    fn round_trip() {
-        macro_rules! check {
-            ($($q:ty),*) => {$(
-                for sys in [Si, Ips, Mm] {
-                    assert_eq!(<$q>::si(-1.2e7).value(sys), -1.2e7 / sys.si_factor(<$q>::DIM));
-                    assert_eq!(<$q>::plain(-1.2e7).value(sys), -1.2e7);
-                }
-            )*};
-        }
-        check!(Length, Area, Time, Velocity, Acceleration, Mass, Density);
-        check!(Stress, Force, ForceDensity, EnergyPerArea, Micromodulus);
-    }
-
-    #[derive(Deserialize, Debug)]
-    #[serde(deny_unknown_fields)]
-    struct Deck {
-        e: Stress,
-    }
-
-    fn stress(src: &str) -> Result<Stress, String> {
-        toml::from_str::<Deck>(src)
-            .map(|d| d.e)
-            .map_err(|e| e.to_string())
-    }
-
-    fn position(src: &str) -> Result<[f64; 3], String> {
-        #[derive(Deserialize)]
-        struct V {
-            x: Position,
-        }
-        let v: V = toml::from_str(&format!("x = {src}")).map_err(|e| e.to_string())?;
-        Ok(v.x.value(Ips))
-    }
-
-    #[test]
-    fn toml_quantity() {
-        let err = stress("\ne = \"3 in\"\n").unwrap_err();
-        assert!(err.contains("stress") && err.contains("length") && err.contains("line 2"));
-        let msg = r#"expected a stress (M L^-1 T^-2), e.g. "25 GPa", but "3 in" is a length (L)"#;
-        assert!(err.contains(msg), "{err}");
-        assert_eq!(stress("e = 3e9"), Ok(Stress::plain(3e9)));
-        assert_eq!(stress("e = 4000"), Ok(Stress::plain(4000.0)));
-        assert_eq!(stress("e = \"25 GPa\"").unwrap().value(Si), 2.5e10);
-        assert_eq!(stress("e = \"3605 ksi\"").unwrap().value(Ips), 3.605e6);
-        assert_eq!(stress("e = \"30 MPa\"").unwrap().value(Mm), 30.0);
-        assert_eq!("5 mm".parse::<Length>().unwrap().value(Si), 0.005);
-        let err = stress("e = \"3605 ksii\"").unwrap_err();
-        assert!(err.contains(r#"unknown unit "ksii" in "3605 ksii"; known units: m,"#));
-        assert!(stress("e = true").is_err() && stress("e = 1\nf = 2").is_err());
-    }
-
-    #[test]
-    fn toml_vector() {
-        assert_eq!(position("\"200 50 30 in\""), Ok([200.0, 50.0, 30.0]));
-        assert_eq!(position("[1, 2.5, 3]"), Ok([1.0, 2.5, 3.0]));
-        assert_eq!(position("\"0 0 -1e-3\""), Ok([0.0, 0.0, -1e-3]));
-        assert_eq!(position(r#"["1 in", "2 in", "3 in"]"#), Ok([1.0, 2.0, 3.0]));
-        for bad in [
-            "[1, 2]",
-            "[1, 2, 3, 4]",
-            "\"1 2 in\"",
-            "\"1 2 3 4 in\"",
-            "[1, 2, \"3 s\"]",
-        ] {
-            assert!(position(bad).unwrap_err().contains("line 1"), "{bad}");
-        }
-        assert_eq!(position("\"0.5 1 3 ft\""), Ok([6.0, 12.0, 36.0]));
-        let err = position("\"1 2 3 s\"").unwrap_err();
-        assert!(err.contains("length") && err.contains("time"), "{err}");
-    }
-}
+#[path = "units_tests.rs"]
+mod tests;

@@ -159,6 +159,10 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     /// The LAMMPS pair style of the same law (`"peri/pmb"`), which `pdq bench --peer` runs on
     /// the benchmark scene; `None`: LAMMPS has none.
     const LAMMPS_PEER: Option<&'static str> = None;
+    /// Whether the model's particles have bonds. A bondless model (`point`: particles that
+    /// only move) is given no horizon: the deck leaves `horizon` and `m` out, no bond is
+    /// searched for, and with no bond to bound the time step the deck gives `[time] dt`.
+    const BONDED: bool = true;
 
     /// Changes during a run: generalized coordinates, then their velocities, then extras.
     type Alter: Attributes;
@@ -376,6 +380,8 @@ pub struct ModelInfo {
     pub first_order: usize,
     /// [`Model::LAMMPS_PEER`].
     pub lammps_peer: Option<&'static str>,
+    /// [`Model::BONDED`].
+    pub bonded: bool,
     /// [`Model::sample`].
     pub sample: fn(&SampleOf) -> Option<Sample>,
 }
@@ -393,6 +399,7 @@ impl ModelInfo {
             force: <M::Force as Attributes>::FIELDS,
             first_order: M::FIRST_ORDER,
             lammps_peer: M::LAMMPS_PEER,
+            bonded: M::BONDED,
             sample: M::sample,
         }
     }

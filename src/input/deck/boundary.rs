@@ -1,9 +1,10 @@
-//! `[[boundary]]`, `[[load]]` and `[[initial]]`: what is held or moved, what pushes or heats,
-//! and the state at the start, each on a region and (boundaries and loads) with a history.
+//! `[[boundary]]`, `[[load]]`, `[[initial]]` and `[velocity]`: what is held or moved, what
+//! pushes or heats, and the state at the start, each on a region and (boundaries and loads)
+//! with a history.
 
 use super::convert::{valid_name, Converter, R};
-use super::sections::{BoundarySection, HistorySpec, InitialSection, LoadSection};
-use super::spec::{BoundarySpec, InitialSpec, LoadKind, LoadSpec, Region};
+use super::sections::{BoundarySection, HistorySpec, InitialSection, LoadSection, VelocitySection};
+use super::spec::{BoundarySpec, InitialSpec, LoadKind, LoadSpec, Region, VelocitySpec};
 use crate::engine::boundary::{History, Motion, TEMPERATURE};
 use toml::Spanned;
 
@@ -86,6 +87,40 @@ impl Converter {
             initial.push(spec);
         }
         Ok(initial)
+    }
+
+    /// `[velocity]`: a temperature ≥ 0 and a seed ≥ 0, on a region (default: every particle).
+    pub(super) fn velocity(
+        &self,
+        section: Option<&Spanned<VelocitySection>>,
+    ) -> R<Option<VelocitySpec>> {
+        let Some(section) = section else {
+            return Ok(None);
+        };
+        let line = self.line_of(section);
+        let v = section.get_ref();
+        if !(v.temperature.is_finite() && v.temperature >= 0.0) {
+            return self.err(
+                line,
+                format!("[velocity] temperature must be ≥ 0 (got {})", v.temperature),
+            );
+        }
+        if v.seed < 0 {
+            return self.err(
+                line,
+                format!("[velocity] seed must be an integer ≥ 0 (got {})", v.seed),
+            );
+        }
+        let region = match &v.region {
+            Some(r) => self.region(r, line, "[velocity]")?,
+            None => Region::All,
+        };
+        Ok(Some(VelocitySpec {
+            line,
+            temperature: v.temperature,
+            seed: v.seed as u64,
+            region,
+        }))
     }
 
     fn history(&self, h: &Option<HistorySpec>, line: usize, ctx: &str) -> R<History> {

@@ -78,13 +78,15 @@ impl Converter {
                 "the deck has no [[geometry]] or [[bar]] entry: there are no particles",
             );
         }
-        let time = self.time(deck.time)?;
+        let bondless = (!model.bonded).then_some(model.name.as_str());
+        let time = self.time(deck.time, bondless)?;
         let boundaries = self.boundaries(&deck.boundary)?;
         let loads = self.loads(&deck.load, &boundaries)?;
         let initial = self.initial(&deck.initial)?;
+        let velocity = self.velocity(deck.velocity.as_ref())?;
         let output = self.output(deck.output.as_ref(), stem)?;
         let parallel = self.parallel(deck.parallel.as_ref())?;
-        let solver = self.solver(deck.solver.as_ref())?;
+        let solver = self.solver(deck.solver.as_ref(), bondless)?;
         let pair = self.pair(deck.pair.as_ref(), &names)?;
         if let (Some(p), false) = (&pair, solver.item == super::spec::SolverSpec::Explicit) {
             return self.err(
@@ -120,6 +122,7 @@ impl Converter {
             boundaries,
             loads,
             initial,
+            velocity,
             output,
             probes,
             solver,

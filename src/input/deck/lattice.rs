@@ -1,17 +1,50 @@
-//! `[lattice]`: the spacing, origin and jitter of the particle lattice, and its periodic axes.
+//! `[lattice]`: the kind, spacing (or density), origin and jitter of the particle lattice, and
+//! its periodic axes.
 
 use super::convert::{Converter, R};
 use super::sections::LatticeSection;
-use crate::input::geometry::Lattice;
+use crate::input::geometry::{Lattice, LatticeKind};
 use toml::Spanned;
 
 impl Converter {
-    /// The lattice; refuses a spacing that is not positive and jitter outside [0, 0.5) or on a
-    /// periodic lattice.
+    /// The lattice; refuses an unknown kind, a spacing or density that is not positive (or
+    /// both, or neither) and jitter outside [0, 0.5) or on a periodic lattice.
     pub(super) fn lattice(&self, section: &Spanned<LatticeSection>) -> R<Lattice> {
         let line = self.line_of(section);
         let l = section.get_ref();
-        let spacing = l.spacing.value(self.sys);
+        let kind = match l.kind.as_deref().unwrap_or("sc") {
+            "sc" => LatticeKind::Sc,
+            "fcc" => LatticeKind::Fcc,
+            "bcc" => LatticeKind::Bcc,
+            other => {
+                return self.err(
+                    line,
+                    format!("[lattice] unknown kind '{other}' (use \"sc\", \"fcc\" or \"bcc\")"),
+                )
+            }
+        };
+        let spacing = match (l.spacing, l.density) {
+            (Some(s), None) => s.value(self.sys),
+            (None, Some(rho)) => {
+                let rho = rho.value(self.sys);
+                if !(rho.is_finite() && rho > 0.0) {
+                    return self.err(line, format!("[lattice] density must be > 0 (got {rho})"));
+                }
+                kind.cell_side(rho)
+            }
+            (Some(_), Some(_)) => {
+                return self.err(
+                    line,
+                    "[lattice] give 'spacing' (the cubic cell side) or 'density' (sites per unit volume), not both",
+                )
+            }
+            (None, None) => {
+                return self.err(
+                    line,
+                    "[lattice] needs 'spacing' (the cubic cell side) or 'density' (sites per unit volume)",
+                )
+            }
+        };
         if !(spacing.is_finite() && spacing > 0.0) {
             return self.err(line, format!("lattice spacing must be > 0 (got {spacing})"));
         }
@@ -29,6 +62,7 @@ impl Converter {
             );
         }
         Ok(Lattice {
+            kind,
             spacing,
             origin: l.origin.map(|o| o.value(self.sys)).unwrap_or([0.0; 3]),
             jitter,

@@ -11,7 +11,8 @@
 //! `[model]` and `[materials]` in `model.rs`, `[lattice]` in `lattice.rs`, `[[geometry]]` and
 //! the shapes of regions in `shape.rs`, `[[bar]]` in `bar.rs`, `[[boundary]]`, `[[load]]` and
 //! `[[initial]]` in `boundary.rs`, `[time]` and `[solver]` in `time.rs`, `[output]` and
-//! `[[probe]]` in `output.rs`, `[parallel]` in `parallel.rs`.
+//! `[[probe]]` in `output.rs`, `[parallel]` in `parallel.rs`. A deck in `units = "lj"` is first
+//! searched for values written with units, which it cannot take (`plain.rs`).
 
 mod bar;
 mod boundary;
@@ -21,6 +22,7 @@ mod model;
 mod output;
 mod pair;
 mod parallel;
+mod plain;
 mod sections;
 mod shape;
 mod spec;
@@ -30,6 +32,7 @@ pub use super::materials::MaterialLines;
 pub use spec::{
     BarSpec, BoundarySpec, CriticalStep, InitialSpec, LoadKind, LoadSpec, Located, ModelLines,
     OutputSpec, ParallelSpec, ProbeSpec, Region, RunLength, Scene, SolverSpec, TimeSpec,
+    VelocitySpec,
 };
 
 use convert::{Converter, LineIndex};
@@ -82,5 +85,10 @@ pub fn parse(text: &str, file: &str, stem: &str) -> Result<Scene, DeckError> {
             message: e.message().trim().to_string(),
         }
     })?;
+    if crate::input::units::UnitSystem::from_name(deck.units.get_ref())
+        == Ok(crate::input::units::UnitSystem::Lj)
+    {
+        plain::refuse_units(text, file, &lines)?;
+    }
     Converter::new(file, lines).scene(deck, stem)
 }

@@ -13,7 +13,9 @@ pub(super) struct ModelChoice {
     pub(super) name: String,
     pub(super) line: usize,
     pub(super) options: Vec<(String, OptionValue)>,
+    /// 0 for a bondless model ([`crate::model::Model::BONDED`]).
     pub(super) horizon: f64,
+    pub(super) bonded: bool,
     pub(super) partial_volume: bool,
     pub(super) surface_correction: bool,
 }
@@ -46,7 +48,14 @@ impl Converter {
                 "[model] surface_correction = \"energy\" needs a body without periodic axes (the correction is found on the scene without its images)",
             );
         }
-        let horizon = self.horizon(&ms, line, spacing)?;
+        // An unknown name is reported when the model is built; until then it is taken to have
+        // bonds, so that its horizon is checked as always.
+        let bonded = crate::models::find(&ms.name).is_none_or(|m| m.bonded);
+        let horizon = if bonded {
+            self.horizon(&ms, line, spacing)?
+        } else {
+            self.no_horizon(&ms, line, surface_correction)?
+        };
         Ok(ModelChoice {
             name: ms.name,
             line,
@@ -63,6 +72,7 @@ impl Converter {
                 })
                 .collect(),
             horizon,
+            bonded,
             partial_volume: ms.partial_volume.unwrap_or(true),
             surface_correction,
         })
@@ -88,6 +98,27 @@ impl Converter {
             );
         }
         Ok(horizon)
+    }
+
+    /// A bondless model's horizon, 0: it finds no bonds, so the deck gives none, nor a
+    /// surface correction of bonds.
+    fn no_horizon(&self, ms: &ModelSection, line: usize, surface_correction: bool) -> R<f64> {
+        let name = &ms.name;
+        if ms.horizon.is_some() || ms.m.is_some() {
+            return self.err(
+                line,
+                format!("[model] model '{name}' has no bonds, so no horizon: leave out 'horizon' and 'm'"),
+            );
+        }
+        if surface_correction {
+            return self.err(
+                line,
+                format!(
+                    "[model] model '{name}' has no bonds to correct: leave out surface_correction"
+                ),
+            );
+        }
+        Ok(0.0)
     }
 
     /// The materials in name order (their index is the material id), with where each key is.

@@ -4,7 +4,8 @@
 
 use crate::input::materials::MaterialSection;
 use crate::input::units::{
-    AccelerationVector, Area, ForceVector, Length, Position, Stress, Time, Vector, VelocityVector,
+    AccelerationVector, Area, ForceVector, Length, NumberDensity, Position, Stress, Time, Vector,
+    VelocityVector,
 };
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -30,6 +31,8 @@ pub(super) struct DeckFile {
     pub(super) load: Vec<Spanned<LoadSection>>,
     #[serde(default)]
     pub(super) initial: Vec<Spanned<InitialSection>>,
+    #[serde(default)]
+    pub(super) velocity: Option<Spanned<VelocitySection>>,
     #[serde(default)]
     pub(super) output: Option<Spanned<OutputSection>>,
     #[serde(default)]
@@ -102,7 +105,12 @@ pub(super) enum OptionSpec {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct LatticeSection {
-    pub(super) spacing: Length,
+    /// "sc" (default), "fcc" or "bcc".
+    pub(super) kind: Option<String>,
+    /// The cubic cell side; or `density`.
+    pub(super) spacing: Option<Length>,
+    /// Sites per unit volume, giving the cell side (basis / density)^⅓; or `spacing`.
+    pub(super) density: Option<NumberDensity>,
     pub(super) origin: Option<Position>,
     /// Axes that wrap around ("x", "y", "z"): the lattice box repeats along them.
     #[serde(default)]
@@ -223,6 +231,16 @@ pub(super) struct InitialSection {
     pub(super) angular_velocity: Option<Vector<0, 0, -1>>,
     /// Models with a temperature DOF.
     pub(super) temperature: Option<f64>,
+}
+
+/// `[velocity]`: Maxwell–Boltzmann velocities at a temperature.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct VelocitySection {
+    /// In kelvin, or in ε/k_B in an lj deck.
+    pub(super) temperature: f64,
+    pub(super) seed: i64,
+    pub(super) region: Option<ShapeSpec>,
 }
 
 #[derive(Deserialize, Default)]

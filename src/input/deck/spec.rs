@@ -135,6 +135,16 @@ pub struct InitialSpec {
     pub temperature: Option<f64>,
 }
 
+/// `[velocity]`: a Maxwell–Boltzmann start at `temperature` (in the deck's temperature unit:
+/// kelvin, ε/k_B in lj), drawn from `seed`, on the particles of `region`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VelocitySpec {
+    pub line: usize,
+    pub temperature: f64,
+    pub seed: u64,
+    pub region: Region,
+}
+
 /// How the deck's loads are followed in time.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SolverSpec {
@@ -274,6 +284,8 @@ pub struct Scene {
     pub boundaries: Vec<BoundarySpec>,
     pub loads: Vec<LoadSpec>,
     pub initial: Vec<InitialSpec>,
+    /// `[velocity]`, set after `[[initial]]`.
+    pub velocity: Option<VelocitySpec>,
     pub output: OutputSpec,
     pub probes: Vec<ProbeSpec>,
     /// `[solver]`, at line 0 if the deck leaves it out.

@@ -8,9 +8,18 @@ use crate::engine::simulation::Integrator;
 use toml::Spanned;
 
 impl Converter {
-    pub(super) fn time(&self, section: Spanned<TimeSection>) -> R<TimeSpec> {
+    /// `[time]`; `bondless` names a model without bonds, which has no stable step to take a
+    /// fraction of: its deck gives `dt`.
+    pub(super) fn time(
+        &self,
+        section: Spanned<TimeSection>,
+        bondless: Option<&str>,
+    ) -> R<TimeSpec> {
         let line = self.line_of(&section);
         let t = section.into_inner();
+        if let Some(name) = bondless {
+            self.bondless_time(&t, line, name)?;
+        }
         let length = self.run_length(&t, line)?;
         let dt = t.dt.map(|d| d.value(self.sys));
         if let Some(d) = dt {
@@ -74,6 +83,28 @@ impl Converter {
         })
     }
 
+    /// A bondless model's `[time]`: `dt` given, and nothing that derives a step from bonds.
+    fn bondless_time(&self, t: &TimeSection, line: usize, name: &str) -> R<()> {
+        if t.dt.is_none() {
+            return self.err(
+                line,
+                format!("[time] model {name} has no bonds to bound the time step; give [time] dt"),
+            );
+        }
+        let derived = [
+            ("safety_factor", t.safety_factor.is_some()),
+            ("critical_step", t.critical_step.is_some()),
+            ("static_until", t.static_until.is_some()),
+        ];
+        if let Some((key, _)) = derived.iter().find(|(_, given)| *given) {
+            return self.err(
+                line,
+                format!("[time] {key}: model {name} has no bonds, so no stable step or static solve to derive it from; leave it out (dt is the step)"),
+            );
+        }
+        Ok(())
+    }
+
     /// `steps` or `duration`, exactly one.
     fn run_length(&self, t: &TimeSection, line: usize) -> R<RunLength> {
         match (t.steps, t.duration) {
@@ -113,6 +144,7 @@ impl Converter {
     pub(super) fn solver(
         &self,
         section: Option<&Spanned<SolverSection>>,
+        bondless: Option<&str>,
     ) -> R<Located<SolverSpec>> {
         let Some(sec) = section else {
             return Ok(Located {
@@ -122,6 +154,12 @@ impl Converter {
         };
         let line = self.line_of(sec);
         let s = sec.get_ref();
+        if let (Some(name), false) = (bondless, s.kind == "explicit") {
+            return self.err(
+                line,
+                format!("[solver] model {name} has no bonds, so no equilibrium to relax to: only kind = \"explicit\""),
+            );
+        }
         let item = match s.kind.as_str() {
             "explicit" => {
                 if s.load_steps.is_some() || s.tolerance.is_some() || s.max_iterations.is_some() {

@@ -13,6 +13,7 @@ use crate::model::attributes::Attributes;
 use crate::model::{Model, ModelBuild, ModelVisitor};
 use std::time::Instant;
 
+mod maxwell;
 mod pairs;
 mod place;
 mod time_step;
@@ -78,13 +79,15 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
             format!("the stable time step is {dt_critical:e}: check the materials' stiffness and density"),
         ));
     }
-    if !dt_critical.is_finite() {
+    // A bondless model has no stable step; its deck gives dt (checked with `[time]`).
+    if !dt_critical.is_finite() && M::BONDED {
         return Err(scene.error(
             None,
             "no particle has a bond: the horizon is too small for the particle spacing",
         ));
     }
     place::initial_state(&mut particles, scene, &gid_to_index)?;
+    place::thermal_velocities(&mut particles, scene, &gid_to_index)?;
     let constraints = place::constraints(&particles, scene, &gid_to_index)?;
     let loads = place::loads(&particles, scene, &gid_to_index)?;
     let probes = place::probes(&particles, scene);
@@ -174,6 +177,18 @@ fn bonds<M: Model>(
     scene: &Scene,
     bar_of: Vec<u32>,
 ) -> Result<(BondList<M::Bond>, Option<Vec<[f64; 3]>>, BarBonds), DeckError> {
+    if !M::BONDED {
+        if let Some(b) = scene.bars.iter().find(|b| b.prestrain.strain != 0.0) {
+            return Err(scene.error(
+                Some(b.line),
+                format!(
+                    "[[bar]] prestrain: model '{}' has no bonds to prestrain",
+                    M::NAME
+                ),
+            ));
+        }
+        return Ok((no_bonds(particles.len()), None, BarBonds::default()));
+    }
     let mut bonds = BondList::<M::Bond>::find(
         &particles.x0,
         particles.n_owned,
@@ -217,6 +232,16 @@ fn bonds<M: Model>(
     let bars = bar_bonds(model, particles, &bonds, scene, bar_of)?;
     bars.apply(model, &mut bonds, &particles.x0, |i| particles.gid[i]);
     Ok((bonds, correction, bars))
+}
+
+/// The bond list of a bondless model: every family empty. (A search at its horizon, 0, would
+/// find the same, but cells of side 0 cannot cover a scene.)
+fn no_bonds<H: Attributes>(n: usize) -> BondList<H> {
+    let mut families = crate::engine::bonds::Families::new(n, 0.0, 1.0, false);
+    for i in 0..n {
+        families.close(i, &mut []);
+    }
+    families.finish()
 }
 
 /// The bars' calibration factors (bond-based models) and prestrained bond histories; see
@@ -272,12 +297,15 @@ fn bar_bonds<M: Model>(
 }
 
 /// Cells of side ≥ the horizon and ≥ the pair law's `reach` (cutoff + skin) over the scene. A
-/// periodic axis spans the lattice box (particle positions ± half a spacing) exactly, so that
-/// its cells tile one period.
+/// periodic axis spans the lattice box exactly,
+/// so that its cells tile one period: the whole lattice cells its particles occupy (simple
+/// cubic: their extent ± half a spacing, as before the other kinds; fcc and bcc, whose sites lie
+/// on the cell faces: from the lowest cell face to the highest cell's far face, so n cells are
+/// exactly n·a long).
 fn domain(points: &[[f64; 3]], scene: &Scene, reach: f64) -> Result<Domain, DeckError> {
     // With shuffling, bonds are found from current cells: the skin keeps a stretched bond
     // between neighbouring cells.
-    let min_cell = (scene.horizon * (1.0 + scene.parallel.skin)).max(reach);
+    let min_cell = (cell_reach(scene) * (1.0 + scene.parallel.skin)).max(reach);
     let mut grid = CellGrid::covering(points, min_cell);
     let mut period = [0.0; 3];
     for a in 0..3 {
@@ -289,7 +317,7 @@ fn domain(points: &[[f64; 3]], scene: &Scene, reach: f64) -> Result<Domain, Deck
             .iter()
             .map(|p| p[a])
             .fold(f64::NEG_INFINITY, f64::max);
-        let length = hi - lo + scene.spacing;
+        let (start, length) = periodic_span(&scene.lattice, a, lo, hi);
         let n = (length / (min_cell * (1.0 + 1e-9))).floor() as usize;
         if n < 3 {
             return Err(scene.error(
@@ -303,7 +331,7 @@ fn domain(points: &[[f64; 3]], scene: &Scene, reach: f64) -> Result<Domain, Deck
                 ),
             ));
         }
-        grid.origin[a] = lo - 0.5 * scene.spacing;
+        grid.origin[a] = start;
         grid.dims[a] = n;
         grid.size[a] = length / n as f64;
         period[a] = length;
@@ -313,6 +341,31 @@ fn domain(points: &[[f64; 3]], scene: &Scene, reach: f64) -> Result<Domain, Deck
         periodic: scene.periodic,
         period,
     })
+}
+
+/// Where the period along axis `a` starts and how long it is, for particles from `lo` to `hi`
+/// along it: the whole lattice cells they occupy.
+fn periodic_span(lattice: &geometry::Lattice, a: usize, lo: f64, hi: f64) -> (f64, f64) {
+    let s = lattice.spacing;
+    if lattice.kind == geometry::LatticeKind::Sc {
+        return (lo - 0.5 * s, hi - lo + s);
+    }
+    // A site on a cell face may round to just below it; the basis offsets are 0 and ½, so a
+    // millionth of a cell decides nothing else.
+    let o = lattice.origin[a];
+    let cell = |x: f64| ((x - o) / s + 1e-6).floor();
+    let (first, last) = (cell(lo), cell(hi));
+    (o + first * s, (last - first + 1.0) * s)
+}
+
+/// The distance the cells must span: the horizon, or for a bondless model (horizon 0) one
+/// lattice cell, until a pair law gives it a cutoff of its own.
+fn cell_reach(scene: &Scene) -> f64 {
+    if scene.horizon > 0.0 {
+        scene.horizon
+    } else {
+        scene.spacing
+    }
 }
 
 /// Builds model `M` from the deck's materials and horizon (the deck's model name is not

@@ -1,5 +1,6 @@
-//! What the deck places on the particles: initial velocities and temperatures, boundary
-//! conditions, loads and probes, each on the particles its region selects.
+//! What the deck places on the particles: initial velocities and temperatures (`[[initial]]`,
+//! then `[velocity]`'s Maxwell–Boltzmann start), boundary conditions, loads and probes, each on
+//! the particles its region selects.
 
 use crate::engine::boundary::{Constraint, Load, TEMPERATURE};
 use crate::engine::particles::Particles;
@@ -74,6 +75,38 @@ pub(super) fn initial_state<M: Model>(
                 a[2 * n2] = t;
             }
         }
+    }
+    Ok(())
+}
+
+/// `[velocity]`: Maxwell–Boltzmann velocities at the deck's temperature on the particles of
+/// its region (`maxwell.rs`), set after `[[initial]]`, so they replace the translational
+/// velocities `[[initial]]` gave those particles. The mass of each component is the inertia
+/// of its degree of freedom (density × volume).
+pub(super) fn thermal_velocities<M: Model>(
+    particles: &mut Particles<M>,
+    scene: &Scene,
+    gid_to_index: &[u32],
+) -> Result<(), DeckError> {
+    let Some(spec) = &scene.velocity else {
+        return Ok(());
+    };
+    let at = |what: &str| scene.error(Some(spec.line), format!("[velocity]: {what}"));
+    let sel = select(particles, &spec.region, gid_to_index).map_err(|e| at(&e))?;
+    let gid: Vec<u32> = sel.iter().map(|&i| particles.gid[i as usize]).collect();
+    let mass: Vec<[f64; 3]> = sel
+        .iter()
+        .map(|&i| {
+            let inv = particles.inv_inertia[i as usize].as_slice();
+            [1.0 / inv[0], 1.0 / inv[1], 1.0 / inv[2]]
+        })
+        .collect();
+    let kb = scene.units.boltzmann();
+    let v = super::maxwell::velocities(&gid, &mass, spec.temperature, spec.seed, kb)
+        .map_err(|e| at(&e))?;
+    let n2 = second_order::<M>();
+    for (&i, v) in sel.iter().zip(v) {
+        particles.alter[i as usize].as_mut_slice()[n2..n2 + 3].copy_from_slice(&v);
     }
     Ok(())
 }

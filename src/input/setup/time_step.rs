@@ -123,6 +123,12 @@ fn static_start_allowed<M: Model>(scene: &Scene, until: f64) -> Result<(), DeckE
             format!("[[initial]] velocities cannot be combined with [time] static_until = {until:e}: the static start begins the run at rest"),
         ));
     }
+    if let Some(v) = &scene.velocity {
+        return Err(scene.error(
+            Some(v.line),
+            format!("[velocity] cannot be combined with [time] static_until = {until:e}: the static start begins the run at rest"),
+        ));
+    }
     if scene.periodic.iter().any(|&p| p) {
         return Err(scene.error(
             line,
