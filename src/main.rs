@@ -380,5 +380,15 @@ fn models_text() -> String {
             s.push_str(&format!("  option {k}: {v}\n"));
         }
     }
+    s.push_str("\npair laws ([pair] law = ...):\n");
+    for p in pdq::pairs::info() {
+        s.push_str(&format!("{}: {}\n", p.name, p.summary));
+        for (k, v) in p.keys {
+            s.push_str(&format!("  key    {k}: {v}\n"));
+        }
+        if p.skips_bonded {
+            s.push_str("  leaves out pairs joined by an intact bond\n");
+        }
+    }
     s
 }
