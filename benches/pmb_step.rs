@@ -3,6 +3,7 @@
 fn main() {
     let opts = pdq::lab::bench::BenchOptions {
         model: "pmb".into(),
+        scene: "standard".into(),
         threads: vec![1],
         ranks: vec![],
         walls: pdq::parallel::decomposition::Walls::Whole,

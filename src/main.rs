@@ -35,6 +35,15 @@ enum Cmd {
     Models,
     /// Time the standard benchmark scene (shared/bench): µs per particle-step.
     Bench(BenchArgs),
+    /// Plot one history column against another from one or more runs (PNG).
+    Plot(PlotArgs),
+    /// Write a bondless deck's initial state (positions, velocities, one type per material)
+    /// as a LAMMPS data file for `read_data`.
+    LammpsData {
+        deck: PathBuf,
+        /// The data file to write.
+        output: PathBuf,
+    },
 }
 
 #[derive(Args)]
@@ -62,6 +71,30 @@ struct RunArgs {
     /// directory (an output directory or its checkpoints/).
     #[arg(long)]
     restart: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct PlotArgs {
+    /// history.csv files, one line each.
+    #[arg(required = true)]
+    files: Vec<PathBuf>,
+    /// The column along x.
+    #[arg(long)]
+    x: String,
+    /// The column along y.
+    #[arg(long)]
+    y: String,
+    /// Factors on x and y, as X,Y (e.g. 1000,0.001 for mm and kN from m and N).
+    #[arg(long, value_delimiter = ',', default_values_t = [1.0, 1.0])]
+    scale: Vec<f64>,
+    /// Legend names, comma-separated, one per file (default: each file's directory).
+    #[arg(long, value_delimiter = ',')]
+    labels: Vec<String>,
+    #[arg(long, default_value = "")]
+    title: String,
+    /// The PNG to write.
+    #[arg(long)]
+    output: PathBuf,
 }
 
 #[derive(Args)]
@@ -139,6 +172,10 @@ struct StressArgs {
 struct BenchArgs {
     #[arg(long, default_value = "pmb")]
     model: String,
+    /// "standard": the peridynamic block of shared/bench (--model picks the model); "lj": the
+    /// LJ melt of inputs/lj_melt.toml (LAMMPS bench/in.lj; its peer is lj/cut).
+    #[arg(long, default_value = "standard", value_parser = ["standard", "lj"])]
+    scene: String,
     /// Thread counts to time, comma-separated (one procCube per thread).
     #[arg(long, value_delimiter = ',', default_value = "1,2")]
     threads: Vec<usize>,
@@ -157,9 +194,10 @@ struct BenchArgs {
     no_yardstick: bool,
     #[arg(long, default_value_t = 200)]
     steps: u64,
-    /// Lattice cells per edge ((n+1)³ particles); 40 is the standard scene.
-    #[arg(long, default_value_t = 40)]
-    n: usize,
+    /// Lattice cells per edge: (n+1)³ particles, default 40, in the standard scene; 4n³ atoms,
+    /// default 20 (32,000 atoms), in the LJ melt.
+    #[arg(long)]
+    n: Option<usize>,
     /// Also run LAMMPS (`lmp`, or $PDQ_LMP) on the same scene.
     #[arg(long)]
     peer: bool,
@@ -200,6 +238,15 @@ fn main() -> ExitCode {
                 print!("{s}");
                 false
             }),
+        Cmd::Plot(a) => plot(a).map(|()| false),
+        Cmd::LammpsData { deck: path, output } => deck::load(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|scene| pdq::driver::export::lammps_data(&scene))
+            .and_then(|data| {
+                std::fs::write(&output, data.text())
+                    .map_err(|e| format!("writing {}: {e}", output.display()))
+            })
+            .map(|()| false),
         Cmd::Models => {
             print!("{}", models_text());
             Ok(false)
@@ -214,6 +261,25 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `pdq plot`.
+fn plot(a: PlotArgs) -> Result<(), String> {
+    let [sx, sy] = a.scale[..] else {
+        return Err(format!(
+            "--scale takes two factors, X,Y (got {})",
+            a.scale.len()
+        ));
+    };
+    pdq::output::curves::plot_curves(&pdq::output::curves::CurvePlot {
+        files: a.files,
+        x: a.x,
+        y: a.y,
+        scale: [sx, sy],
+        labels: a.labels,
+        title: a.title,
+        output: a.output,
+    })
 }
 
 /// `pdq run`; whether a signal interrupted the run (its checkpoint and outputs are written).
@@ -311,7 +377,8 @@ fn bench_command(a: BenchArgs) -> Result<(), String> {
         procs: a.procs.unwrap_or(pdq::parallel::decomposition::Procs::Auto),
         yardstick: !a.no_yardstick,
         steps: a.steps,
-        n: a.n,
+        n: a.n.unwrap_or(if a.scene == "lj" { 20 } else { 40 }),
+        scene: a.scene,
         peer: a.peer,
         repeat: a.repeat,
         rounds: a.rounds,

@@ -4,6 +4,7 @@
 //! `check` describes a deck without running it.
 
 mod check;
+pub mod export;
 mod observers;
 mod record;
 pub mod run;

@@ -5,7 +5,7 @@ use super::run::Summary;
 use super::step_loop::{Plan, Tally};
 use crate::engine::particles::Particles;
 use crate::engine::timing::Phase;
-use crate::input::deck::SolverSpec;
+use crate::input::deck::{Colouring, SolverSpec};
 use crate::input::setup::Setup;
 use crate::model::attributes::Attributes;
 use crate::model::Model;
@@ -29,7 +29,14 @@ pub(crate) fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
     .collect();
     if setup.sim.pairs.is_some() {
         // total_energy then includes the pairs' energy.
-        for k in ["pair_energy", "pair_virial", "pairs_in_range"] {
+        for k in [
+            "pair_energy",
+            "pair_virial",
+            "pairs_in_range",
+            "potential_energy",
+            "temperature",
+            "pressure",
+        ] {
             c.push(k.into());
         }
     }
@@ -86,6 +93,10 @@ pub(crate) struct Row {
     pub max_damage: f64,
     /// With a pair law: the pairs' energy, virial Σ r·F and the pairs within their cutoff.
     pub pairs: Option<[f64; 3]>,
+    /// With a pair law: the virial of every internal force, bonds and pairs (Σ x·F).
+    pub virial: f64,
+    /// With a pair law: temperature and pressure ([`Thermo::of`]).
+    pub thermo: Option<[f64; 2]>,
     /// Each load's total along its direction, in deck order.
     pub loads: Vec<f64>,
     /// Each constraint's reaction on each of its DOFs, in deck order.
@@ -110,7 +121,11 @@ impl Row {
             self.broken_bonds as f64,
             self.max_damage,
         ];
-        v.extend(self.pairs.iter().flatten());
+        if let Some(p) = self.pairs {
+            v.extend(p);
+            v.push(self.strain_energy + p[0]);
+            v.extend(self.thermo.unwrap_or([f64::NAN; 2]));
+        }
         v.extend_from_slice(&self.loads);
         v.extend_from_slice(&self.reactions);
         v.extend(self.probes.iter().flatten());
@@ -159,7 +174,7 @@ impl Row {
                 .sum(),
         );
         if let Some(t) = pairs {
-            sums.extend([t.energy, t.virial, t.pairs as f64]);
+            sums.extend([t.energy, t.virial, t.pairs as f64, sim.virial]);
         }
         let (step, time) = (sim.step, sim.time);
         let mut team = cube.team();
@@ -184,8 +199,63 @@ impl Row {
                 let at = first_probe + 3 * n_probes + 1;
                 [sums[at], sums[at + 1], sums[at + 2]]
             }),
+            virial: pairs.map_or(0.0, |_| sums[first_probe + 3 * n_probes + 4]),
+            thermo: None,
             solve: None,
         }
+    }
+}
+
+/// What turns a row's kinetic energy and virial into temperature and pressure: Boltzmann's
+/// constant in the deck's units, the translational degrees of freedom and the volume.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Thermo {
+    pub boltzmann: f64,
+    pub dof: f64,
+    pub volume: f64,
+}
+
+impl Thermo {
+    /// The run's constants. Degrees of freedom: the free translational DOFs, less 3 for the
+    /// conserved momentum when no particle is held (LAMMPS's `compute temp`: 3N − 3). Volume:
+    /// along a periodic axis its period, along any other the particles' extent plus one
+    /// lattice spacing (the space their sites stand for).
+    pub fn of_setup<M: Model>(setup: &Setup<M>, boltzmann: f64) -> Thermo {
+        let free = setup.sim.free_dofs();
+        let n2 = crate::model::second_order::<M>();
+        let translational = free
+            .chunks(n2.max(1))
+            .map(|d| d.iter().take(3).filter(|&&f| f).count())
+            .sum::<usize>();
+        let held = translational < 3 * setup.sim.particles.n_owned;
+        let dof = translational as f64 - if held { 0.0 } else { 3.0 };
+        let p = &setup.sim.particles;
+        let mut volume = 1.0;
+        for a in 0..3 {
+            volume *= if setup.domain.periodic[a] {
+                setup.domain.period[a]
+            } else {
+                let along = (0..p.n_owned).map(|i| p.pos(i)[a]);
+                let lo = along.clone().fold(f64::INFINITY, f64::min);
+                let hi = along.fold(f64::NEG_INFINITY, f64::max);
+                hi - lo + setup.spacing
+            };
+        }
+        Thermo {
+            boltzmann,
+            dof: dof.max(1.0),
+            volume,
+        }
+    }
+
+    /// Temperature 2 KE/(dof k_B) and pressure (2 KE + W)/(3V), W = Σ x·F the virial of
+    /// the internal forces (LAMMPS's `compute pressure` with its `virial` of every style).
+    pub fn of(&self, row: &Row) -> [f64; 2] {
+        let ke = row.kinetic_energy;
+        [
+            2.0 * ke / (self.dof * self.boltzmann),
+            (2.0 * ke + row.virial) / (3.0 * self.volume),
+        ]
     }
 }
 
@@ -347,7 +417,7 @@ pub(crate) fn finish<M: Model>(
         cube.sim.strain_energy(),
     ];
     cube.team().reduce(&mut totals, Reduce::Sum);
-    let (position, damage) = final_positions(&mut cube, n_global);
+    let last = final_positions(&mut cube, n_global);
     let broken_pairs = final_broken_pairs(&mut cube);
     let balance = balance_rows(&mut cube);
     let Some(balance) = balance else {
@@ -372,7 +442,10 @@ pub(crate) fn finish<M: Model>(
     }
     std::fs::write(plan.dir.join("timing.txt"), &timing).map_err(io)?;
     if plan.final_state {
-        write_final_state(&plan.dir, &position, &damage, &broken_pairs).map_err(io)?;
+        write_final_state(&plan.dir, &last.position, &last.damage, &broken_pairs).map_err(io)?;
+    }
+    if let Some(colouring) = plan.picture {
+        write_picture(plan, &last, colouring, cube.sim.step, cube.sim.time)?;
     }
     if let Some((_, size, secs)) = tally.checkpoints.last() {
         let _ = writeln!(
@@ -396,8 +469,8 @@ pub(crate) fn finish<M: Model>(
         timing,
         layout: plan.layout.clone(),
         shuffles: tally.shuffles,
-        positions: position,
-        damage,
+        positions: last.position,
+        damage: last.damage,
         broken_pairs,
         interrupted: tally.interrupted,
         checkpoints: tally.checkpoints,
@@ -409,27 +482,115 @@ pub(crate) fn finish<M: Model>(
     }))
 }
 
-/// Current positions and damage by global id, on the root (empty elsewhere).
-fn final_positions<M: Model>(cube: &mut Cube<M>, n_global: usize) -> (Vec<[f64; 3]>, Vec<f64>) {
+/// Current positions and damage by global id, on the root (empty elsewhere); with a picture
+/// to draw, also each particle's material and speed.
+fn final_positions<M: Model>(cube: &mut Cube<M>, n_global: usize) -> Final {
     let damage = cube.damage();
+    let p = &cube.sim.particles;
     let mut mine: Vec<f64> = Vec::new();
     for (i, d) in damage.iter().enumerate() {
-        mine.push(cube.sim.particles.gid[i] as f64);
-        mine.extend_from_slice(&cube.sim.particles.pos(i));
-        mine.push(*d);
+        let v = p.velocity(i);
+        let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        mine.push(p.gid[i] as f64);
+        mine.extend_from_slice(&p.pos(i));
+        mine.extend([*d, p.material[i] as f64, speed]);
     }
     let Some(parts) = cube.team().gather(bytemuck::cast_slice(&mine)) else {
-        return (Vec::new(), Vec::new());
+        return Final::default();
     };
-    let mut position = vec![[f64::NAN; 3]; n_global];
-    let mut damage_by_id = vec![f64::NAN; n_global];
+    let mut f = Final {
+        position: vec![[f64::NAN; 3]; n_global],
+        damage: vec![f64::NAN; n_global],
+        material: vec![0.0; n_global],
+        speed: vec![0.0; n_global],
+    };
     for bytes in parts {
-        for rec in f64s(&bytes).chunks_exact(5) {
-            position[rec[0] as usize] = [rec[1], rec[2], rec[3]];
-            damage_by_id[rec[0] as usize] = rec[4];
+        for rec in f64s(&bytes).chunks_exact(7) {
+            let id = rec[0] as usize;
+            f.position[id] = [rec[1], rec[2], rec[3]];
+            f.damage[id] = rec[4];
+            f.material[id] = rec[5];
+            f.speed[id] = rec[6];
         }
     }
-    (position, damage_by_id)
+    f
+}
+
+/// The final state by global id, on the root.
+#[derive(Default)]
+struct Final {
+    position: Vec<[f64; 3]>,
+    damage: Vec<f64>,
+    material: Vec<f64>,
+    speed: Vec<f64>,
+}
+
+/// `picture.png`: the final state from the side and in 3D, coloured as the deck asked.
+fn write_picture(
+    plan: &Plan,
+    f: &Final,
+    colouring: Colouring,
+    step: u64,
+    time: f64,
+) -> Result<(), String> {
+    let scaled = |v: &[f64], lo: f64, hi: f64| -> Vec<f64> {
+        v.iter().map(|x| (x - lo) / (hi - lo).max(1e-300)).collect()
+    };
+    let range = |v: &[f64]| {
+        v.iter()
+            .filter(|x| x.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            })
+    };
+    let (value, scale) = match colouring {
+        Colouring::Damage => (f.damage.clone(), crate::output::plot::damage_scale()),
+        Colouring::Material => {
+            let last = plan.material_names.len().saturating_sub(1);
+            let names = &plan.material_names;
+            let ends = [
+                names.first().cloned().unwrap_or_default(),
+                names.last().cloned().unwrap_or_default(),
+            ];
+            (scaled(&f.material, 0.0, last as f64), ends)
+        }
+        Colouring::Speed => {
+            let (_, hi) = range(&f.speed);
+            (
+                scaled(&f.speed, 0.0, hi),
+                ["speed 0".into(), format!("{hi:.3e}")],
+            )
+        }
+        Colouring::Height => {
+            let z: Vec<f64> = f.position.iter().map(|x| x[2]).collect();
+            let (lo, hi) = range(&z);
+            (
+                scaled(&z, lo, hi),
+                [format!("z {lo:.3e}"), format!("{hi:.3e}")],
+            )
+        }
+    };
+    let what = match colouring {
+        Colouring::Material => {
+            format!("material ({}, blue to red)", plan.material_names.join(", "))
+        }
+        other => other.name().to_string(),
+    };
+    crate::output::plot::particle_views(
+        &plan.dir.join("picture.png"),
+        &format!(
+            "{}: step {step}, t = {time:.4e}, coloured by {what}",
+            plan.title
+        ),
+        &crate::output::plot::Body {
+            x0: &f.position,
+            displacement: &vec![[0.0; 3]; f.position.len()],
+            value: &value,
+            spacing: plan.spacing,
+            scale,
+        },
+        1.0,
+    )
 }
 
 /// The broken bonds as sorted (smaller, larger) global id pairs, on the root.

@@ -1,6 +1,6 @@
 //! `pdq run` and `pdq check`: drive a simulation built from a deck and report on it.
 
-use super::record::{columns, frame_store};
+use super::record::{columns, frame_store, Thermo};
 use super::step_loop::{drive, CheckpointPlan, Plan, SolverChoice};
 use crate::input::deck::{Scene, SolverSpec};
 use crate::input::setup::{self, Setup};
@@ -313,6 +313,13 @@ impl<M: Model> Prepared<'_, M> {
                 scene_hash: self.scene_hash,
                 deck: scene.file.clone(),
             },
+            thermo: setup
+                .sim
+                .pairs
+                .is_some()
+                .then(|| Thermo::of_setup(setup, scene.units.boltzmann())),
+            picture: out.picture,
+            title: scene.title.clone(),
         }
     }
 

@@ -40,6 +40,12 @@ pub(crate) struct Plan {
     pub material_names: Vec<String>,
     pub spacing: f64,
     pub checkpoints: CheckpointPlan,
+    /// With a pair law: how rows get their temperature and pressure.
+    pub thermo: Option<super::record::Thermo>,
+    /// `[output] picture`: what `picture.png` of the final state is coloured by.
+    pub picture: Option<crate::input::deck::Colouring>,
+    /// The deck's title, for the picture.
+    pub title: String,
 }
 
 /// When to write checkpoints, and what identifies them.

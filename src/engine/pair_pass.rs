@@ -36,8 +36,9 @@ pub struct PairTally {
 /// The non-bonded forces of a run, whatever its law: one boxed value per procCube, called once
 /// per step (no dispatch per pair).
 pub trait NonBonded<M: Model>: Send {
-    /// Adds every listed pair's force to both ends (ghost ends included).
-    fn add_forces(&mut self, p: &mut Particles<M>);
+    /// Adds every listed pair's force to both ends (ghost ends included), leaving out pairs
+    /// whose bond (when the law skips bonded pairs) is still intact.
+    fn add_forces(&mut self, p: &mut Particles<M>, bonds: &BondList<M::Bond>);
     /// Whether some owned particle moved more than half the skin since the last build.
     fn moved_too_far(&self, p: &Particles<M>) -> bool;
     /// Rebuilds the list from the current positions.
@@ -63,12 +64,16 @@ pub struct PairPass<L: PairLaw> {
     skip_bonded: bool,
     offsets: Vec<u32>,
     partner: Vec<u32>,
+    /// For each listed pair, the bond joining it when it was built (`NO_BOND`: none): the pair
+    /// acts from the step its bond breaks, so that new crack faces touch without a rebuild.
+    bond_of: Vec<u32>,
     /// Owned positions at the last build.
     at_build: Vec<[f64; 3]>,
-    /// Scratch of the build: bond partners of each particle, both ways.
+    /// Scratch of the build: bond partners of each particle, both ways, with the bond's index.
     bonded_start: Vec<u32>,
-    bonded: Vec<u32>,
+    bonded: Vec<(u32, u32)>,
     mark: Vec<u32>,
+    mark_bond: Vec<u32>,
     tally: PairTally,
     builds: u64,
     /// The material of every particle at the last build, if there is only one.
@@ -83,10 +88,12 @@ impl<L: PairLaw> PairPass<L> {
             skin,
             offsets: vec![0],
             partner: Vec::new(),
+            bond_of: Vec::new(),
             at_build: Vec::new(),
             bonded_start: Vec::new(),
             bonded: Vec::new(),
             mark: Vec::new(),
+            mark_bond: Vec::new(),
             tally: PairTally::default(),
             builds: 0,
             single: None,
@@ -112,19 +119,21 @@ impl<L: PairLaw> PairPass<L> {
             self.bonded_start[i + 1] += self.bonded_start[i];
         }
         self.bonded.clear();
-        self.bonded.resize(self.bonded_start[n] as usize, 0);
+        self.bonded.resize(self.bonded_start[n] as usize, (0, 0));
         // `mark` doubles as the fill cursor here; it is reset below.
         self.mark.clear();
         self.mark.extend_from_slice(&self.bonded_start[..n]);
         for (i, j, k) in bonds.iter() {
             if !bonds.broken[k] {
-                self.bonded[self.mark[i] as usize] = j as u32;
+                self.bonded[self.mark[i] as usize] = (j as u32, k as u32);
                 self.mark[i] += 1;
-                self.bonded[self.mark[j] as usize] = i as u32;
+                self.bonded[self.mark[j] as usize] = (i as u32, k as u32);
                 self.mark[j] += 1;
             }
         }
         self.mark.iter_mut().for_each(|m| *m = u32::MAX);
+        self.mark_bond.clear();
+        self.mark_bond.resize(n, NO_BOND);
     }
 }
 
@@ -134,8 +143,11 @@ fn pos<M: Model>(p: &Particles<M>, i: usize) -> [f64; 3] {
     [a[0], a[1], a[2]]
 }
 
+/// No bond joins the pair.
+const NO_BOND: u32 = u32::MAX;
+
 impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
-    fn add_forces(&mut self, p: &mut Particles<M>) {
+    fn add_forces(&mut self, p: &mut Particles<M>, bonds: &BondList<M::Bond>) {
         assert_eq!(
             self.offsets.len(),
             p.n_owned + 1,
@@ -147,7 +159,14 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
             let xi = pos(p, i);
             let mi = p.material[i];
             let mut fi = [0.0; 3];
-            for &j in &self.partner[self.offsets[i] as usize..self.offsets[i + 1] as usize] {
+            let listed = self.offsets[i] as usize..self.offsets[i + 1] as usize;
+            for (&j, &b) in self.partner[listed.clone()]
+                .iter()
+                .zip(&self.bond_of[listed])
+            {
+                if b != NO_BOND && !bonds.broken[b as usize] {
+                    continue;
+                }
                 let j = j as usize;
                 let xj = pos(p, j);
                 let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
@@ -205,7 +224,9 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
         let PairPass {
             offsets,
             partner,
+            bond_of,
             mark,
+            mark_bond,
             bonded_start,
             bonded,
             skip_bonded,
@@ -215,22 +236,26 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
         offsets.clear();
         offsets.resize(p.n_owned + 1, 0);
         partner.clear();
+        bond_of.clear();
         for (k, shell) in cells.half_shell.iter().enumerate() {
             let own = cells.cell_range[k].clone();
             for i in own.clone() {
                 let xi = pos(p, i);
                 if skip {
                     let s = bonded_start[i] as usize..bonded_start[i + 1] as usize;
-                    for &j in &bonded[s] {
+                    for &(j, k) in &bonded[s] {
                         mark[j as usize] = i as u32;
+                        mark_bond[j as usize] = k;
                     }
                 }
                 let mut visit = |j: usize| {
                     let xj = pos(p, j);
                     let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
                     let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                    if r2 < r2max && !(skip && mark[j] == i as u32) {
+                    if r2 < r2max {
                         partner.push(j as u32);
+                        let bonded = skip && mark[j] == i as u32;
+                        bond_of.push(if bonded { mark_bond[j] } else { NO_BOND });
                     }
                 };
                 for j in i + 1..own.end {

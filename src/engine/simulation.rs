@@ -77,6 +77,10 @@ pub struct Simulation<M: Model> {
     pub timing: Timing,
     /// The non-bonded pass, if the deck has a `[pair]` law; `None` costs nothing.
     pub pairs: Option<Box<dyn NonBonded<M>>>,
+    /// With a pair law: Σ x·F of the last evaluation over this procCube's held particles (owned
+    /// and ghost), before the force return: the virial of every internal force, bonds and
+    /// pairs, whose sum over procCubes gives the pressure.
+    pub virial: f64,
 }
 
 impl<M: Model> Simulation<M> {
@@ -93,6 +97,7 @@ impl<M: Model> Simulation<M> {
             step: 0,
             timing: Timing::default(),
             pairs: None,
+            virial: 0.0,
         }
     }
 
@@ -133,7 +138,8 @@ impl<M: Model> Simulation<M> {
         let broken = forces::pair_pass(&self.model, p, &mut self.bonds);
         t = self.timing.lap(Phase::Forces, t);
         if let Some(pairs) = &mut self.pairs {
-            pairs.add_forces(p);
+            pairs.add_forces(p, &self.bonds);
+            self.virial = held_virial(p);
             t = self.timing.lap(Phase::Pairs, t);
         }
         exchange.reverse_force(p);
@@ -240,6 +246,19 @@ impl<M: Model> Simulation<M> {
     pub fn kinetic_energy(&self) -> f64 {
         self.particles.kinetic_energy()
     }
+}
+
+/// Σ x·F over every held particle, ghosts included, before the force return (the virial by
+/// "F dot r", as LAMMPS's `fdotr`): a ghost sits at its periodic image, so each bond or pair
+/// counts (x_i − x_j)·F_ij once whichever procCube holds its ends, and no bond needs its own
+/// tally.
+fn held_virial<M: Model>(p: &Particles<M>) -> f64 {
+    (0..p.len())
+        .map(|i| {
+            let (x, f) = (p.pos(i), &p.force[i].as_slice()[..3]);
+            x[0] * f[0] + x[1] * f[1] + x[2] * f[2]
+        })
+        .sum()
 }
 
 /// Σ_j V_j C_ij for each particle and DOF, C_ij the bond stiffness of [`Model::bond_stiffness`]:

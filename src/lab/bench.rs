@@ -11,6 +11,7 @@ use crate::parallel;
 use crate::parallel::decomposition::{Procs, Walls};
 use std::fmt::Write as _;
 
+mod lj;
 mod peer;
 mod ranks;
 mod savings;
@@ -26,6 +27,8 @@ pub use yardstick::hand_pmb_pass;
 #[derive(Clone, Debug)]
 pub struct BenchOptions {
     pub model: String,
+    /// "standard" (the peridynamic block of `shared/bench`) or "lj" (the LJ melt).
+    pub scene: String,
     /// Thread counts to time, one line each.
     pub threads: Vec<usize>,
     /// MPI rank counts to time (each through `mpirun`), one line each.
@@ -35,7 +38,8 @@ pub struct BenchOptions {
     /// Whether to time the yardstick (generic against hand-written PMB loop).
     pub yardstick: bool,
     pub steps: u64,
-    /// Lattice cells per edge: (n + 1)³ particles; 40 is the standard scene.
+    /// Lattice cells per edge: (n + 1)³ particles, 40 in the standard scene; 4n³ atoms, 20 in
+    /// the LJ melt.
     pub n: usize,
     pub peer: bool,
     /// Repetitions of the yardstick comparison (medians are reported).
@@ -157,6 +161,19 @@ pub fn run(opts: &BenchOptions) -> Result<String, String> {
     if opts.savings {
         return savings(opts);
     }
+    if !["standard", "lj"].contains(&opts.scene.as_str()) {
+        return Err(format!(
+            "unknown bench scene '{}' (use standard or lj)",
+            opts.scene
+        ));
+    }
+    if opts.scene == "lj" {
+        // The yardstick is a hand-written PMB loop: nothing to compare a pair law with.
+        return run_one(&BenchOptions {
+            yardstick: false,
+            ..opts.clone()
+        });
+    }
     if opts.model == "all" {
         let mut out = String::new();
         for model in bench_models() {
@@ -176,8 +193,21 @@ pub fn run(opts: &BenchOptions) -> Result<String, String> {
     run_one(opts)
 }
 
+/// What the lines call the benchmark: the model, or for the LJ melt its pair law.
+fn bench_name(opts: &BenchOptions) -> &str {
+    if opts.scene == "lj" {
+        "lj"
+    } else {
+        &opts.model
+    }
+}
+
 fn run_one(opts: &BenchOptions) -> Result<String, String> {
-    let text = standard_deck(&opts.model, opts.n, opts.steps)?;
+    let text = if opts.scene == "lj" {
+        lj::lj_deck(opts.n)?
+    } else {
+        standard_deck(&opts.model, opts.n, opts.steps)?
+    };
     let scene = deck::parse(&text, "<bench>", "bench").map_err(|e| e.to_string())?;
     struct Visit<'a>(&'a deck::Scene, &'a BenchOptions);
     impl ModelVisitor for Visit<'_> {
@@ -206,8 +236,8 @@ fn run_one(opts: &BenchOptions) -> Result<String, String> {
                             out,
                             "bench ratio lammps/pdq={:.2} (model={} vs {}, 1 core each)",
                             theirs / ours,
-                            opts.model,
-                            peer_style(&opts.model)
+                            bench_name(opts),
+                            peer_style(opts)
                         );
                     }
                 }
@@ -221,27 +251,46 @@ fn run_one(opts: &BenchOptions) -> Result<String, String> {
 /// The standard line of one parallel run. Memory is what the engine stores for the model's
 /// declared records: per particle (engine fields, Alter, Fixed, State, Force and inverse
 /// inertia) and per bond (partner, geometry, broken flag, history), ghosts and buffers aside.
-fn line<M: Model>(
+fn line(
+    name: &str,
+    bytes: [usize; 2],
     particles: usize,
     steps: u64,
     threads: usize,
     ranks: usize,
     t: &parallel::Timed,
 ) -> String {
+    let us = 1e6 * t.seconds / (particles as f64 * steps as f64);
+    let head = format!(
+        "bench model={name} particles={particles} steps={steps} threads={threads} ranks={ranks} us_per_particle_step={us:.4}"
+    );
+    let tail = format!(
+        "seconds={:.3} comm_percent={:.1} bytes_per_step={:.0} bytes_per_particle={}",
+        t.seconds,
+        100.0 * t.comm_seconds / t.seconds.max(1e-300),
+        t.bytes_per_step,
+        bytes[0],
+    );
+    if t.bonds == 0 {
+        // A bondless scene (the LJ melt): its cost is per particle and pair.
+        return format!("{head} {tail}");
+    }
     format!(
-        "bench model={} particles={particles} steps={steps} threads={threads} ranks={ranks} us_per_particle_step={:.4} ns_per_bond={:.3} bonds_per_second={:.4e} bonds={} broken={} seconds={:.3} comm_percent={:.1} bytes_per_step={:.0} bytes_per_particle={} bytes_per_bond={}",
-        M::NAME,
-        1e6 * t.seconds / (particles as f64 * steps as f64),
+        "{head} ns_per_bond={:.3} bonds_per_second={:.4e} bonds={} broken={} {tail} bytes_per_bond={}",
         1e9 * t.seconds / (t.bonds as f64 * steps as f64),
         t.bonds as f64 * steps as f64 / t.seconds,
         t.bonds,
         t.broken,
-        t.seconds,
-        100.0 * t.comm_seconds / t.seconds.max(1e-300),
-        t.bytes_per_step,
+        bytes[1],
+    )
+}
+
+/// The engine's bytes per particle and per bond of model `M`.
+fn bytes_of<M: Model>() -> [usize; 2] {
+    [
         crate::engine::particles::Particles::<M>::bytes_per_particle(),
         crate::engine::bonds::BondList::<M::Bond>::bytes_per_bond(),
-    )
+    ]
 }
 
 /// `key=value` of a standard line.
@@ -381,7 +430,12 @@ fn bench_setup<M: Model>(
         let timed = parallel::on_threads(cubes, |c| c.timed_steps(opts.steps));
         let t = &timed[0];
         let us = 1e6 * t.seconds / (n as f64 * opts.steps as f64);
-        let _ = write!(out, "{}", line::<M>(n, opts.steps, threads, 1, t));
+        let name = bench_name(opts);
+        let _ = write!(
+            out,
+            "{}",
+            line(name, bytes_of::<M>(), n, opts.steps, threads, 1, t)
+        );
         let entry = per_count.entry(threads).or_default();
         entry.0.push(us);
         if threads == 1 {
@@ -412,7 +466,7 @@ fn bench_setup<M: Model>(
             let _ = write!(
                 out,
                 "bench median model={} threads={threads} runs={} us_per_particle_step={:.4}",
-                M::NAME,
+                bench_name(opts),
                 us.len(),
                 median(us.clone())
             );

@@ -1,4 +1,5 @@
-//! PNG plots of validation results: measured points against a reference curve. The font is
+//! PNG plots: measured points against a reference curve, and pictures of a body's particles
+//! (a side and a 3D view) coloured by damage, material, speed or height. The font is
 //! DejaVu Sans compiled in, so no system fonts are needed.
 
 use plotters::prelude::*;
@@ -107,18 +108,26 @@ pub fn xy(
     Ok(())
 }
 
-/// The particles of one frame, for [`damage_views`].
+/// The particles of one frame, for [`particle_views`].
 pub struct Body<'a> {
     /// Reference positions.
     pub x0: &'a [[f64; 3]],
     pub displacement: &'a [[f64; 3]],
-    pub damage: &'a [f64],
+    /// What each particle is coloured by, scaled to 0..1 (damage as it is).
+    pub value: &'a [f64],
     /// Lattice spacing: each particle is drawn as a square of this size.
     pub spacing: f64,
+    /// The words at the two ends of the colour bar (value 0 and 1).
+    pub scale: [String; 2],
 }
 
-/// Damage from 0 (intact, blue) through yellow to 1 (all bonds broken, dark red), the thesis's
-/// figures' reading: cracks stand out against an intact body.
+/// The colour bar's ends for damage.
+pub fn damage_scale() -> [String; 2] {
+    ["damage 0".into(), "1".into()]
+}
+
+/// 0 (blue) through yellow to 1 (dark red): for damage the thesis's figures' reading, cracks
+/// standing out against an intact body.
 fn damage_colour(d: f64) -> RGBColor {
     let stops: [(f64, [f64; 3]); 5] = [
         (0.0, [40.0, 70.0, 160.0]),
@@ -139,15 +148,15 @@ fn damage_colour(d: f64) -> RGBColor {
     RGBColor(c(0), c(1), c(2))
 }
 
-/// Writes the deformed body coloured by damage to `path` (PNG, 1200 × 960): a side view (along
-/// +y, the x–z plane) above an oblique 3D view from the front, left and above. Displacements
+/// Writes the deformed body coloured by its values (damage, or what [`Body::scale`] names) to
+/// `path` (PNG, 1200 × 960): a side view (along +y, the x–z plane) above an oblique 3D view from the front, left and above. Displacements
 /// are drawn `magnify` times; particles are squares painted far to near, so what shows is the
 /// body's visible surface, as in the thesis's figures.
-pub fn damage_views(path: &Path, title: &str, body: &Body, magnify: f64) -> Result<(), String> {
+pub fn particle_views(path: &Path, title: &str, body: &Body, magnify: f64) -> Result<(), String> {
     register_font();
     let err = |e: &dyn std::fmt::Display| format!("plot {}: {e}", path.display());
     let n = body.x0.len();
-    if n == 0 || body.displacement.len() != n || body.damage.len() != n {
+    if n == 0 || body.displacement.len() != n || body.value.len() != n {
         return Err(format!("plot {}: no particles to draw", path.display()));
     }
     let deformed: Vec<[f64; 3]> = body
@@ -183,7 +192,7 @@ pub fn damage_views(path: &Path, title: &str, body: &Body, magnify: f64) -> Resu
     ] {
         draw_projection(area, &deformed, body, basis, label).map_err(|e| err(&e))?;
     }
-    draw_colour_bar(&oblique).map_err(|e| err(&e))?;
+    draw_colour_bar(&oblique, &body.scale).map_err(|e| err(&e))?;
     root.present().map_err(|e| err(&e))?;
     Ok(())
 }
@@ -258,7 +267,7 @@ fn draw_projection(
         let b = (b.0.max(a.0 + 1), b.1.max(a.1 + 1));
         area.draw(&Rectangle::new(
             [a, b],
-            damage_colour(body.damage[i]).filled(),
+            damage_colour(body.value[i]).filled(),
         ))?;
     }
     area.draw(&Text::new(
@@ -269,8 +278,8 @@ fn draw_projection(
     Ok(())
 }
 
-/// A horizontal damage scale in the lower right corner of `area`.
-fn draw_colour_bar(area: &Area) -> Result<(), Box<dyn std::error::Error>> {
+/// A horizontal colour scale in the lower right corner of `area`, `ends` written at its ends.
+fn draw_colour_bar(area: &Area, ends: &[String; 2]) -> Result<(), Box<dyn std::error::Error>> {
     let (w, h) = area.dim_in_pixel();
     let (x0, y0, len) = (w as i32 - 330, h as i32 - 40, 240);
     for k in 0..len {
@@ -281,8 +290,10 @@ fn draw_colour_bar(area: &Area) -> Result<(), Box<dyn std::error::Error>> {
         ))?;
     }
     let font = ("sans-serif", 14).into_font();
-    area.draw(&Text::new("damage 0", (x0 - 70, y0), font.clone()))?;
-    area.draw(&Text::new("1", (x0 + len + 6, y0), font))?;
+    // About 7 pixels a character at this size: the left end's words end at the bar.
+    let left = x0 - 6 - 7 * ends[0].chars().count() as i32;
+    area.draw(&Text::new(ends[0].clone(), (left.max(4), y0), font.clone()))?;
+    area.draw(&Text::new(ends[1].clone(), (x0 + len + 6, y0), font))?;
     Ok(())
 }
 
@@ -309,10 +320,11 @@ mod tests {
         let body = Body {
             x0: &x0,
             displacement: &[[0.0; 3]; 3],
-            damage: &[1.0, 0.0, 0.5],
+            value: &[1.0, 0.0, 0.5],
             spacing: 1.0,
+            scale: damage_scale(),
         };
-        damage_views(&path, "test", &body, 1.0).unwrap();
+        particle_views(&path, "test", &body, 1.0).unwrap();
         let (width, rgb) = pixels(&path);
         let count = |c: RGBColor| {
             rgb.chunks_exact(3)

@@ -37,9 +37,6 @@ pub struct Cube<M: Model> {
     pub lost: Vec<u32>,
     /// Those bonds as (smaller, larger) global ids, kept by the owner of the smaller.
     pub dropped: Vec<(u32, u32)>,
-    /// A bond broke since the neighbour lists were built: pairs they left out as bonded may
-    /// now touch, so the next step rebuilds them.
-    pub(crate) broke_since_build: bool,
 }
 
 /// Boundary conditions, loads and probes of the whole scene, by global id.
@@ -201,7 +198,6 @@ pub fn build_cube<M: Model>(
         global_particles: g.len(),
         everywhere,
         dropped: Vec::new(),
-        broke_since_build: false,
     }
 }
 
@@ -276,7 +272,6 @@ impl<M: Model> Cube<M> {
             self.refresh_pairs()?;
         }
         let broken = self.sim.compute_forces_with(&mut self.wall);
-        self.broke_since_build |= broken > 0;
         self.sim.end_step();
         Ok(broken)
     }
@@ -287,15 +282,14 @@ impl<M: Model> Cube<M> {
     /// and is found once. Every worker must call it at every step: the test is a reduction.
     fn refresh_pairs(&mut self) -> Result<(), String> {
         let t = std::time::Instant::now();
-        let far = self.broke_since_build
-            || self
-                .sim
-                .pairs
-                .as_ref()
-                .is_some_and(|pairs| pairs.moved_too_far(&self.sim.particles));
+        let far = self
+            .sim
+            .pairs
+            .as_ref()
+            .is_some_and(|pairs| pairs.moved_too_far(&self.sim.particles));
         if self.team().max(if far { 1.0 } else { 0.0 }) > 0.0 {
+            // The shuffle builds the lists from the redrawn cells.
             self.shuffle_now()?;
-            self.build_pair_list();
         }
         self.sim.timing.lap(crate::engine::timing::Phase::Pairs, t);
         Ok(())
@@ -309,8 +303,8 @@ impl<M: Model> Cube<M> {
         self.build_pair_list();
     }
 
-    fn build_pair_list(&mut self) {
-        self.broke_since_build = false;
+    /// Builds the neighbour lists from the current cells; ghosts must hold current positions.
+    pub(crate) fn build_pair_list(&mut self) {
         if let Some(pairs) = &mut self.sim.pairs {
             let cells = crate::engine::pair_pass::CellPairs {
                 cell_range: &self.plan.cell_range,

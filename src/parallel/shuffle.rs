@@ -140,7 +140,11 @@ impl<M: Model> Cube<M> {
         self.wall.set_stages(plan.stages.clone());
         self.plan = plan;
         self.layout = layout;
-        // Ghosts are refreshed by the next step's exchange; forces came with their particles.
+        // Ghosts came current from the whole scene, forces with their particles. The neighbour
+        // lists held the old local indices: they are built again here.
+        if self.sim.pairs.is_some() {
+            self.build_pair_list();
+        }
         Ok(())
     }
 

@@ -141,3 +141,50 @@ pub fn layout(threads: usize, procs: [usize; 3]) -> pdq::driver::run::RunOptions
         ..Default::default()
     }
 }
+
+/// inputs/lj_melt.toml at 8 × 8 × 8 fcc cells (2,048 atoms), 200 steps, final state written.
+#[allow(dead_code)]
+pub fn lj_deck() -> String {
+    let text = std::fs::read_to_string("inputs/lj_melt.toml").unwrap();
+    for old in [
+        "max = [33.5, 33.5, 33.5]",
+        "steps = 100",
+        "progress = false",
+    ] {
+        assert!(text.contains(old), "inputs/lj_melt.toml lost '{old}'");
+    }
+    text.replace("max = [33.5, 33.5, 33.5]", "max = [13.4, 13.4, 13.4]")
+        .replace("steps = 100", "steps = 200")
+        .replace("progress = false", "progress = false\nfinal_state = true")
+        + "\n[parallel]\nshuffle_every = 10\n"
+}
+
+/// Final positions by id.
+#[allow(dead_code)]
+pub fn final_positions(dir: &std::path::Path) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(dir.join("final_positions.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            [v[1], v[2], v[3]]
+        })
+        .collect()
+}
+
+/// Largest distance between the same atom in two runs, over periodic images of a cube of side
+/// `period` (an atom may be wrapped into the box in one run and not yet in another).
+#[allow(dead_code)]
+pub fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]], period: f64) -> f64 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .flat_map(|(x, y)| {
+            (0..3).map(move |k| {
+                let d = x[k] - y[k];
+                (d - period * (d / period).round()).abs()
+            })
+        })
+        .fold(0.0, f64::max)
+}

@@ -57,6 +57,7 @@ impl<M: Model> Observer<M> for HistoryRows<'_> {
         let plan = self.plan;
         let damage = watch.damage(cube);
         let mut row = Row::reduced(cube, damage, plan.probe_stops.len());
+        row.thermo = plan.thermo.map(|t| t.of(&row));
         // Every worker has the whole row, so all stop alike.
         let probe_halt = plan
             .probe_stops

@@ -30,9 +30,9 @@ mod time;
 
 pub use super::materials::MaterialLines;
 pub use spec::{
-    BarSpec, BoundarySpec, CriticalStep, InitialSpec, LoadKind, LoadSpec, Located, ModelLines,
-    OutputSpec, ParallelSpec, ProbeSpec, Region, RunLength, Scene, SolverSpec, TimeSpec,
-    VelocitySpec,
+    BarSpec, BoundarySpec, Colouring, CriticalStep, InitialSpec, LoadKind, LoadSpec, Located,
+    ModelLines, OutputSpec, ParallelSpec, ProbeSpec, Region, RunLength, Scene, SolverSpec,
+    TimeSpec, VelocitySpec,
 };
 
 use convert::{Converter, LineIndex};

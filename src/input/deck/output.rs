@@ -3,7 +3,7 @@
 
 use super::convert::{valid_name, Converter, R};
 use super::sections::{OutputSection, ProbeSection};
-use super::spec::{OutputSpec, ProbeSpec};
+use super::spec::{Colouring, OutputSpec, ProbeSpec};
 use std::path::PathBuf;
 use toml::Spanned;
 
@@ -36,6 +36,18 @@ impl Converter {
             checkpoint_minutes: out.checkpoint_minutes.unwrap_or(0.0),
             checkpoint_keep: out.checkpoint_keep.unwrap_or(3),
             restart: out.restart.as_ref().map(PathBuf::from),
+            picture: match out.picture.as_deref() {
+                None | Some("none") => None,
+                Some(name) => Some(Colouring::parse(name).ok_or_else(|| {
+                    self.error_at(
+                        line,
+                        format!(
+                            "[output] picture '{name}' is not known (use {} or \"none\")",
+                            Colouring::NAMES.map(|n| format!("\"{n}\"")).join(", ")
+                        ),
+                    )
+                })?),
+            },
         };
         if !(output.checkpoint_minutes.is_finite() && output.checkpoint_minutes >= 0.0) {
             return self.err(line, "[output] checkpoint_minutes must be ≥ 0");

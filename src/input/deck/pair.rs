@@ -22,11 +22,16 @@ impl Converter {
         };
         let line = self.line_of(section);
         let s = section.get_ref();
+        // "none" switches a deck's pair law off without deleting its tables (the cyclic bar's
+        // run without contact).
+        if s.law == "none" {
+            return Ok(None);
+        }
         if !crate::pairs::names().contains(&s.law.as_str()) {
             return self.err(
                 line,
                 format!(
-                    "[pair] unknown law '{}' (known laws: {})",
+                    "[pair] unknown law '{}' (known laws: {}, or none)",
                     s.law,
                     crate::pairs::names().join(", ")
                 ),

@@ -255,6 +255,7 @@ pub(super) struct OutputSection {
     pub(super) checkpoint_minutes: Option<f64>,
     pub(super) checkpoint_keep: Option<usize>,
     pub(super) restart: Option<String>,
+    pub(super) picture: Option<String>,
 }
 
 #[derive(Deserialize)]

@@ -179,6 +179,39 @@ pub struct OutputSpec {
     pub checkpoint_keep: usize,
     /// Resume from this checkpoint file, or the newest in this directory.
     pub restart: Option<PathBuf>,
+    /// `picture.png` of the final state, coloured by this (`None`: no picture).
+    pub picture: Option<Colouring>,
+}
+
+/// What the particles of a picture are coloured by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Colouring {
+    /// Broken fraction of each particle's bonds, 0 to 1.
+    Damage,
+    /// The particle's material, in the order `pdq check` lists them.
+    Material,
+    /// |v|, from 0 to the largest.
+    Speed,
+    /// z of the current position, from the lowest to the highest.
+    Height,
+}
+
+impl Colouring {
+    pub const NAMES: [&'static str; 4] = ["damage", "material", "speed", "height"];
+
+    pub fn parse(name: &str) -> Option<Colouring> {
+        Some(match name {
+            "damage" => Colouring::Damage,
+            "material" => Colouring::Material,
+            "speed" => Colouring::Speed,
+            "height" => Colouring::Height,
+            _ => return None,
+        })
+    }
+
+    pub fn name(self) -> &'static str {
+        Colouring::NAMES[self as usize]
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -10,10 +10,14 @@ const LAMMPS_LPS: &str = "units si\nboundary s s s\natom_style peri\natom_modify
 
 const LAMMPS_PMB: &str = "units si\nboundary s s s\natom_style peri\natom_modify map array\nlattice sc 0.001\nregion box block 0 ${n} 0 ${n} 0 ${n}\ncreate_box 1 box\ncreate_atoms 1 region box\npair_style peri/pmb\npair_coeff * * 1.6863e22 0.0030150 0.0005 0.25\nset group all density 2200\nset group all volume 1.0e-9\nvelocity all set 0.0 0.0 0.0 sum no units box\nregion top block INF INF INF INF $(v_n-2) ${n} units lattice\ngroup top region top\nvelocity top set 0.0 0.0 1.0 sum no units box\nneighbor 0.0010 bin\nfix 1 all nve\ntimestep 1.0e-7\nthermo 100\nrun ${steps}\n";
 
-/// The LAMMPS pair style a model is compared with: its own peer ([`crate::model::Model::LAMMPS_PEER`]),
-/// else `peri/pmb`, whose solid the benchmark's is.
-pub(super) fn peer_style(model: &str) -> &'static str {
-    crate::models::find(model)
+/// The LAMMPS pair style a bench is compared with: `lj/cut` on the LJ melt; on the standard
+/// scene the model's own peer ([`crate::model::Model::LAMMPS_PEER`]), else `peri/pmb`, whose
+/// solid the benchmark's is.
+pub(super) fn peer_style(opts: &BenchOptions) -> &'static str {
+    if opts.scene == "lj" {
+        return "lj/cut";
+    }
+    crate::models::find(&opts.model)
         .and_then(|m| m.lammps_peer)
         .unwrap_or("peri/pmb")
 }
@@ -28,11 +32,11 @@ pub(super) fn peer(
     let lmp = std::env::var("PDQ_LMP").unwrap_or_else(|_| "lmp".into());
     let dir = std::env::temp_dir().join(format!("pdq-bench-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let style = peer_style(&opts.model);
-    let (name, text) = if style == "peri/lps" {
-        ("lammps_lps.in", LAMMPS_LPS)
-    } else {
-        ("lammps_pmb.in", LAMMPS_PMB)
+    let style = peer_style(opts);
+    let (name, text) = match style {
+        "lj/cut" => ("lammps_lj.in", super::lj::LAMMPS_LJ),
+        "peri/lps" => ("lammps_lps.in", LAMMPS_LPS),
+        _ => ("lammps_pmb.in", LAMMPS_PMB),
     };
     let input = dir.join(name);
     std::fs::write(&input, text).map_err(|e| e.to_string())?;

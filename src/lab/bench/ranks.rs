@@ -1,8 +1,8 @@
 //! `pdq bench --ranks`: the standard scene under `mpirun`, one procCube per rank.
 
-#[cfg(feature = "mpi")]
-use super::line;
 use super::BenchOptions;
+#[cfg(feature = "mpi")]
+use super::{bench_name, bytes_of, line};
 #[cfg(feature = "mpi")]
 use crate::input::{deck, setup};
 #[cfg(feature = "mpi")]
@@ -31,7 +31,15 @@ impl ModelVisitor for MpiVisit<'_> {
         Ok(if rank == 0 {
             format!(
                 "{} launcher=mpirun layout={}\n",
-                line::<M>(n, self.1.steps, 1, ranks, &t),
+                line(
+                    bench_name(self.1),
+                    bytes_of::<M>(),
+                    n,
+                    self.1.steps,
+                    1,
+                    ranks,
+                    &t
+                ),
                 layout.describe().replace(' ', "_")
             )
         } else {
@@ -64,6 +72,8 @@ pub(super) fn ranks_line(opts: &BenchOptions, ranks: usize) -> Result<String, St
             "bench",
             "--model",
             &opts.model,
+            "--scene",
+            &opts.scene,
             "--threads",
             "1",
             "--no-yardstick",

@@ -69,11 +69,13 @@ pub(super) fn savings(opts: &BenchOptions) -> Result<String, String> {
     let pmb = standard_deck(plain, n, steps)?;
     let unbreakable = pmb.replace("critical_stretch = 0.0005\n", "");
     let shuffling = format!("{pmb}[parallel]\nshuffle_every = 10\n");
+    let contact = format!("{pmb}[pair]\nlaw = \"contact\"\n");
     // (feature, deck using it, threads, shuffle_every, deck without it, what differs)
-    let pairs: [(&str, String, usize, u64, String, String); 4] = [
+    let pairs: [(&str, String, usize, u64, String, String); 5] = [
         ("damage checks", pmb.clone(), 1, 0, unbreakable, format!("{plain} with critical stretch 0.0005 against none (the engine drops the broken flags and break tests from the bond loop)")),
         ("state pass", standard_deck(state, n, steps)?, 1, 0, pmb.clone(), format!("{state} against {plain}, same scene: the state pass, its two exchanges and the state-based law")),
         ("rotation DOFs", standard_deck(rotating, n, steps)?, 1, 0, pmb.clone(), format!("{rotating} (6 DOFs, moments) against {plain} (3 DOFs), same stiffness; the difference includes the larger law")),
+        ("contact pairs", contact, 1, 0, pmb.clone(), format!("{plain} with [pair] law = \"contact\" (the non-bonded pass: list builds from the cells, the crack-face check, the contact force) against no [pair], which skips the pass with one branch per step")),
         ("shuffling", shuffling, 2, 10, pmb, format!("{plain} on 2 threads with shuffle_every = 10 (cells widened by the 0.25 skin) against small-motion mode")),
     ];
     let mut out = String::new();

@@ -316,14 +316,15 @@ pub(super) fn draw_damage_views(dir: &Path, path: &Path, title: &str) -> Result<
         .get(volumes.len() / 2)
         .ok_or_else(|| format!("{}: the last frame has no particles", dir.display()))?
         .cbrt();
-    crate::output::plot::damage_views(
+    crate::output::plot::particle_views(
         path,
         &format!("{title}; displacements × {magnify:.1}"),
         &crate::output::plot::Body {
             x0: &frame.x0,
             displacement: &frame.u,
-            damage: &frame.damage,
+            value: &frame.damage,
             spacing,
+            scale: crate::output::plot::damage_scale(),
         },
         magnify,
     )

@@ -1,0 +1,43 @@
+//! Layout invariance of the non-bonded pass (issue 23): the LJ melt over 200 steps, its
+//! neighbour lists rebuilt (with a shuffle) as atoms move and a shuffle every 10 steps besides,
+//! follows the same trajectory to round-off on 1, 2 and 4 procCubes on threads (the MPI ranks'
+//! version is in tests/mpi_runs.rs).
+
+mod common;
+use common::{final_positions, layout, lj_deck, max_distance, run_quietly};
+
+#[test]
+fn the_lj_melt_is_the_same_on_1_2_and_4_threads() {
+    let text = lj_deck();
+    let base = std::env::temp_dir().join(format!("pdq-md-layouts-{}", std::process::id()));
+    let one = base.join("one");
+    run_quietly(&text, "lj.toml", &one, layout(1, [1, 1, 1])).unwrap();
+    let reference = final_positions(&one);
+    assert_eq!(reference.len(), 2048);
+    let period = 8.0 * (4.0f64 / 0.8442).cbrt();
+    // The atoms moved: the comparison is of a trajectory, not of a lattice.
+    let start = pdq::input::setup::build_as::<pdq::models::point::Point>(
+        &pdq::input::deck::parse(&text, "lj.toml", "lj").unwrap(),
+    )
+    .unwrap()
+    .sim
+    .particles
+    .x0;
+    let moved = max_distance(&reference, &start, period);
+    assert!(moved > 0.3, "atoms moved at most {moved}");
+    let history = std::fs::read_to_string(one.join("history.csv")).unwrap();
+    for (threads, procs) in [(2, [2, 1, 1]), (4, [2, 2, 1]), (4, [1, 2, 2])] {
+        let dir = base.join(format!("{procs:?}"));
+        run_quietly(&text, "lj.toml", &dir, layout(threads, procs)).unwrap();
+        let d = max_distance(&reference, &final_positions(&dir), period);
+        eprintln!("{threads} threads {procs:?}: positions within {d:.2e} of one thread's");
+        assert!(d < 1e-9, "{procs:?}: positions differ by {d:e}");
+        let other = std::fs::read_to_string(dir.join("history.csv")).unwrap();
+        assert_eq!(other.lines().count(), history.lines().count());
+    }
+    // The same layout again: bit-identical.
+    let again = base.join("again");
+    run_quietly(&text, "lj.toml", &again, layout(1, [1, 1, 1])).unwrap();
+    assert!(final_positions(&again) == reference, "one thread twice");
+    std::fs::remove_dir_all(&base).ok();
+}
