@@ -2,8 +2,7 @@
 //! the membrane rises where it is pulled, and the cyclic notched bar carries compression through its closed
 //! crack with contact and not without. Each run also draws its picture.
 
-mod common;
-use common::{final_positions, run_quietly};
+use crate::common::{final_positions, run_quietly};
 use std::path::Path;
 
 fn example(name: &str) -> String {

@@ -3,8 +3,7 @@
 //! follows the same trajectory to round-off on 1, 2 and 4 procCubes on threads (the MPI ranks'
 //! version is in tests/mpi_runs.rs).
 
-mod common;
-use common::{final_positions, layout, lj_deck, max_distance, run_quietly};
+use crate::common::{final_positions, layout, lj_deck, max_distance, run_quietly};
 
 #[test]
 fn the_lj_melt_is_the_same_on_1_2_and_4_threads() {

@@ -1,0 +1,11 @@
+//! Molecular dynamics and the non-bonded pass (issue 23), one test binary: the MD input
+//! (`input`), the thermo against LAMMPS from the same start (`lammps_thermo`), layout
+//! invariance on threads (`layouts`) and the example scenes at a small size (`scenes`).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod input;
+mod lammps_thermo;
+mod layouts;
+mod scenes;
