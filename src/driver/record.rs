@@ -33,6 +33,9 @@ pub(crate) fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
             c.push(k.into());
         }
     }
+    if setup.sim.thermostat.is_some() {
+        c.push("conserved_energy".into());
+    }
     for l in &setup.sim.loads {
         c.push(format!("load_{}", l.name));
     }
@@ -86,6 +89,8 @@ pub(crate) struct Row {
     pub max_damage: f64,
     /// With a pair law: the pairs' energy, virial Σ r·F and the pairs within their cutoff.
     pub pairs: Option<[f64; 3]>,
+    /// With a thermostat: the energy it holds (`Thermostat::reservoir`), a global value.
+    pub reservoir: Option<f64>,
     /// Each load's total along its direction, in deck order.
     pub loads: Vec<f64>,
     /// Each constraint's reaction on each of its DOFs, in deck order.
@@ -111,6 +116,10 @@ impl Row {
             self.max_damage,
         ];
         v.extend(self.pairs.iter().flatten());
+        if let Some(r) = self.reservoir {
+            let pairs = self.pairs.map_or(0.0, |p| p[0]);
+            v.push(self.kinetic_energy + self.strain_energy + pairs + r);
+        }
         v.extend_from_slice(&self.loads);
         v.extend_from_slice(&self.reactions);
         v.extend(self.probes.iter().flatten());
@@ -185,6 +194,7 @@ impl Row {
                 [sums[at], sums[at + 1], sums[at + 2]]
             }),
             solve: None,
+            reservoir: cube.sim.thermostat.as_ref().map(|t| t.reservoir()),
         }
     }
 }
