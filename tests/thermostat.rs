@@ -204,7 +204,7 @@ fn berendsen_and_rescale_reach_their_target_and_count_what_they_take() {
         .map(|r| (r[conserved] - rows[0][conserved]).abs())
         .fold(0.0, f64::max);
     eprintln!("berendsen: total energy rose by {put_in:.2}, total + reservoir moved by {kept:.2e}");
-    assert!(put_in > 300.0 && kept < 1e-3 * put_in, "{put_in} {kept}");
+    assert!(put_in > 300.0 && kept < 2e-3 * put_in, "{put_in} {kept}");
     let _ = std::fs::remove_dir_all(&dir);
 
     // Rescale every 10 steps: exactly T₀ right after each.
