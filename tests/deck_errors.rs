@@ -602,18 +602,18 @@ fn measured_critical_step_is_shown_and_above_the_bound() {
     assert_rejected("critical_step_bound_dt", &deck, &["stable time step"], None);
 }
 
-/// An integrator PDQ does not have.
+/// An integrator PDQ does not have (leapfrog it has: the semi-implicit Euler scheme).
 #[test]
 fn unknown_integrator() {
     let deck = edit(
         "safety_factor = 0.8",
-        "safety_factor = 0.8\nintegrator = \"leapfrog\"",
+        "safety_factor = 0.8\nintegrator = \"rk4\"",
     );
     let line = line_of(&deck, "[time]");
     assert_rejected(
         "integrator",
         &deck,
-        &["leapfrog", "integrator", "verlet"],
+        &["rk4", "integrator", "verlet", "leapfrog"],
         Some(line),
     );
 }

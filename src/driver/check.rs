@@ -105,7 +105,31 @@ pub(crate) fn describe<M: Model>(setup: &Setup<M>, scene: &Scene) -> String {
             l.particles.len()
         );
     }
+    if let Some(t) = &sim.thermostat {
+        let _ = writeln!(s, "{}", describe_thermostat(t, n));
+    }
     s
+}
+
+/// The thermostat's line: kind, target, time constant and group, for checking a group before
+/// a long run.
+fn describe_thermostat(t: &crate::engine::thermostat::Thermostat, n: usize) -> String {
+    use crate::engine::thermostat::Kind;
+    let group = t
+        .member
+        .as_ref()
+        .map_or(n, |m| m.iter().filter(|&&b| b).count());
+    let how = match t.kind {
+        Kind::Rescale { every } => format!("every {every} steps"),
+        Kind::Berendsen { tau } | Kind::NoseHoover { tau, .. } => format!("damping {tau:.4e}"),
+        Kind::Langevin { tau, seed } => format!("damping {tau:.4e}, seed {seed}"),
+    };
+    format!(
+        "thermostat {} to T = {} ({how}) on {group} particles, {} degrees of freedom",
+        t.kind.name(),
+        t.temperature,
+        t.dof
+    )
 }
 
 /// `pdq check`: builds everything, times a few steps and reports without running.

@@ -40,6 +40,9 @@ pub(crate) fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
             c.push(k.into());
         }
     }
+    if setup.sim.thermostat.is_some() {
+        c.push("conserved_energy".into());
+    }
     for l in &setup.sim.loads {
         c.push(format!("load_{}", l.name));
     }
@@ -97,6 +100,8 @@ pub(crate) struct Row {
     pub virial: f64,
     /// With a pair law: temperature and pressure ([`Thermo::of`]).
     pub thermo: Option<[f64; 2]>,
+    /// With a thermostat: the energy it holds (`Thermostat::reservoir`), a global value.
+    pub reservoir: Option<f64>,
     /// Each load's total along its direction, in deck order.
     pub loads: Vec<f64>,
     /// Each constraint's reaction on each of its DOFs, in deck order.
@@ -125,6 +130,10 @@ impl Row {
             v.extend(p);
             v.push(self.strain_energy + p[0]);
             v.extend(self.thermo.unwrap_or([f64::NAN; 2]));
+        }
+        if let Some(r) = self.reservoir {
+            let pairs = self.pairs.map_or(0.0, |p| p[0]);
+            v.push(self.kinetic_energy + self.strain_energy + pairs + r);
         }
         v.extend_from_slice(&self.loads);
         v.extend_from_slice(&self.reactions);
@@ -202,6 +211,7 @@ impl Row {
             virial: pairs.map_or(0.0, |_| sums[first_probe + 3 * n_probes + 4]),
             thermo: None,
             solve: None,
+            reservoir: cube.sim.thermostat.as_ref().map(|t| t.reservoir()),
         }
     }
 }

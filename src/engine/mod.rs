@@ -14,4 +14,5 @@ pub mod particles;
 pub mod random;
 pub mod simulation;
 pub mod spectrum;
+pub mod thermostat;
 pub mod timing;

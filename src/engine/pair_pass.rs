@@ -105,6 +105,60 @@ impl<L: PairLaw> PairPass<L> {
         &self.partner[self.offsets[i] as usize..self.offsets[i + 1] as usize]
     }
 
+    /// Every listed pair's force on both ends; with `SKIP`, not while the pair's bond is intact.
+    fn sweep<M: Model, const SKIP: bool>(
+        &self,
+        p: &mut Particles<M>,
+        broken: &[bool],
+    ) -> PairTally {
+        let single = self.single;
+        let mut t = PairTally::default();
+        for i in 0..p.n_owned {
+            let xi = pos(p, i);
+            let mi = p.material[i];
+            let mut fi = [0.0; 3];
+            let listed = self.offsets[i] as usize..self.offsets[i + 1] as usize;
+            for (k, &j) in listed.clone().zip(&self.partner[listed]) {
+                if SKIP {
+                    let b = self.bond_of[k];
+                    if b != NO_BOND && !broken[b as usize] {
+                        continue;
+                    }
+                }
+                let j = j as usize;
+                let xj = pos(p, j);
+                let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
+                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                let c = match single {
+                    Some(m) => self.law.coeff(m, m),
+                    None => self.law.coeff(mi, p.material[j]),
+                };
+                let vv = if L::VOLUMES {
+                    p.volume[i] * p.volume[j]
+                } else {
+                    1.0
+                };
+                let Some((fr, u)) = self.law.eval(&c, r2, vv) else {
+                    continue;
+                };
+                let f = [fr * d[0], fr * d[1], fr * d[2]];
+                let fj = p.force[j].as_mut_slice();
+                for k in 0..3 {
+                    fi[k] -= f[k];
+                    fj[k] += f[k];
+                }
+                t.energy += u;
+                t.virial += fr * r2;
+                t.pairs += 1;
+            }
+            let f = p.force[i].as_mut_slice();
+            for k in 0..3 {
+                f[k] += fi[k];
+            }
+        }
+        t
+    }
+
     /// Every intact bond's two ends, as lists per particle (owned and ghost).
     fn index_bonds<H: Attributes>(&mut self, n: usize, bonds: &BondList<H>) {
         self.bonded_start.clear();
@@ -153,52 +207,12 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
             p.n_owned + 1,
             "the neighbour list was not built for these particles"
         );
-        let single = self.single;
-        let mut t = PairTally::default();
-        for i in 0..p.n_owned {
-            let xi = pos(p, i);
-            let mi = p.material[i];
-            let mut fi = [0.0; 3];
-            let listed = self.offsets[i] as usize..self.offsets[i + 1] as usize;
-            for (&j, &b) in self.partner[listed.clone()]
-                .iter()
-                .zip(&self.bond_of[listed])
-            {
-                if b != NO_BOND && !bonds.broken[b as usize] {
-                    continue;
-                }
-                let j = j as usize;
-                let xj = pos(p, j);
-                let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
-                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                let c = match single {
-                    Some(m) => self.law.coeff(m, m),
-                    None => self.law.coeff(mi, p.material[j]),
-                };
-                let vv = if L::VOLUMES {
-                    p.volume[i] * p.volume[j]
-                } else {
-                    1.0
-                };
-                let Some((fr, u)) = self.law.eval(&c, r2, vv) else {
-                    continue;
-                };
-                let f = [fr * d[0], fr * d[1], fr * d[2]];
-                let fj = p.force[j].as_mut_slice();
-                for k in 0..3 {
-                    fi[k] -= f[k];
-                    fj[k] += f[k];
-                }
-                t.energy += u;
-                t.virial += fr * r2;
-                t.pairs += 1;
-            }
-            let f = p.force[i].as_mut_slice();
-            for k in 0..3 {
-                f[k] += fi[k];
-            }
-        }
-        self.tally = t;
+        // Laws that never skip bonded pairs (LJ and friends) read no bond index per pair.
+        self.tally = if self.skip_bonded {
+            self.sweep::<M, true>(p, &bonds.broken)
+        } else {
+            self.sweep::<M, false>(p, &[])
+        };
     }
 
     fn moved_too_far(&self, p: &Particles<M>) -> bool {

@@ -1,9 +1,9 @@
 //! One procCube's time stepping: particles and bonds, forces, loads and constraints, integration.
 //!
 //! ```text
-//! first-order DOFs (Euler) → kick → constrain → drift → exchange (forward)
-//!      → [state pass → reverse-sum → finish] → pair pass → reverse force sum
-//!      → loads, constraints → kick → constrain
+//! [thermostat half step] → first-order DOFs (Euler) → kick → constrain → drift
+//!      → exchange (forward) → [state pass → reverse-sum → finish] → pair pass
+//!      → reverse force sum → loads, constraints → kick → constrain → [thermostat]
 //! ```
 //! The exchange points are where the wall method's ghost messages go. The step is handed the
 //! exchange (`parallel::wall::WallExchange` on procCubes); a simulation on its own, with no
@@ -14,6 +14,7 @@ use crate::engine::boundary::{Constraint, Load};
 use crate::engine::forces;
 use crate::engine::pair_pass::NonBonded;
 use crate::engine::particles::Particles;
+use crate::engine::thermostat::Thermostat;
 use crate::engine::timing::{Phase, Timing};
 use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model};
@@ -24,15 +25,27 @@ use std::time::Instant;
 pub enum Integrator {
     /// Velocity Verlet (half kick, drift, forces, half kick): second order, symplectic.
     VelocityVerlet,
-    /// The thesis's scheme (appendix A.3.2): v += Δt·F/m, then x += Δt·v.
-    SemiImplicitEuler,
+    /// The thesis's scheme (appendix A.3.2): v += Δt·F/m, then x += Δt·v. Read with the
+    /// stored velocities as half-step ones, v(t + Δt/2) = v(t − Δt/2) + Δt·F(t)/m, it is the
+    /// leapfrog scheme, whose positions are velocity Verlet's (docs/theory.md §10).
+    Leapfrog,
 }
 
 impl Integrator {
     pub fn name(self) -> &'static str {
         match self {
             Integrator::VelocityVerlet => "velocity-verlet",
-            Integrator::SemiImplicitEuler => "semi-implicit-euler",
+            Integrator::Leapfrog => "leapfrog",
+        }
+    }
+
+    /// The integrator a deck or a checkpoint names. "euler" and "semi-implicit-euler" are the
+    /// leapfrog's older names (checkpoints written before it was named say the latter).
+    pub fn from_name(name: &str) -> Option<Integrator> {
+        match name {
+            "verlet" | "velocity-verlet" => Some(Integrator::VelocityVerlet),
+            "leapfrog" | "euler" | "semi-implicit-euler" => Some(Integrator::Leapfrog),
+            _ => None,
         }
     }
 }
@@ -81,6 +94,8 @@ pub struct Simulation<M: Model> {
     /// and ghost), before the force return: the virial of every internal force, bonds and
     /// pairs, whose sum over procCubes gives the pressure.
     pub virial: f64,
+    /// The deck's `[thermostat]`, if any.
+    pub thermostat: Option<Thermostat>,
 }
 
 impl<M: Model> Simulation<M> {
@@ -98,6 +113,7 @@ impl<M: Model> Simulation<M> {
             timing: Timing::default(),
             pairs: None,
             virial: 0.0,
+            thermostat: None,
         }
     }
 
@@ -200,11 +216,34 @@ impl<M: Model> Simulation<M> {
     }
 
     /// [`Simulation::advance`] with ghost data moved by `exchange`.
+    /// A simulation stepped on its own is the whole scene: the thermostat's sums are its own.
     pub fn advance_with(&mut self, exchange: &mut impl Exchange<M>) -> usize {
+        self.thermostat_begin(&mut |_| {});
         self.begin_step();
         let broken = self.compute_forces_with(exchange);
         self.end_step();
+        self.thermostat_end(&mut |_| {});
         broken
+    }
+
+    /// The thermostat's part before [`Simulation::begin_step`]; `sum` adds a slice over every
+    /// procCube of the run.
+    pub fn thermostat_begin(&mut self, sum: &mut dyn FnMut(&mut [f64])) {
+        if let Some(t) = &mut self.thermostat {
+            let start = Instant::now();
+            t.begin_step(&mut self.particles, self.dt, sum);
+            self.timing.lap(Phase::Integration, start);
+        }
+    }
+
+    /// The thermostat's part after [`Simulation::end_step`]; `sum` as for
+    /// [`Simulation::thermostat_begin`].
+    pub fn thermostat_end(&mut self, sum: &mut dyn FnMut(&mut [f64])) {
+        if let Some(t) = &mut self.thermostat {
+            let start = Instant::now();
+            t.end_step(&mut self.particles, self.dt, self.step, sum);
+            self.timing.lap(Phase::Integration, start);
+        }
     }
 
     /// The part of a step before its force evaluation: first-order DOFs, the first kick, the
@@ -216,7 +255,7 @@ impl<M: Model> Simulation<M> {
         self.advance_first_order(dt);
         match self.integrator {
             Integrator::VelocityVerlet => self.kick(0.5 * dt),
-            Integrator::SemiImplicitEuler => self.kick(dt),
+            Integrator::Leapfrog => self.kick(dt),
         }
         for c in &self.constraints {
             c.set_drift_velocity(&mut self.particles, t0, dt);

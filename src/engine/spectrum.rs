@@ -25,7 +25,7 @@ pub const LANCZOS_STEPS: usize = 30;
 /// coordinates' size at most).
 const PROBE_DISPLACEMENT: f64 = 1e-6;
 
-/// The critical time step of central differences (velocity Verlet and semi-implicit Euler
+/// The critical time step of central differences (velocity Verlet and the leapfrog
 /// alike), 2/√λ_max(M⁻¹K) over the second-order DOFs that no boundary condition holds, with M
 /// the particles' masses (and rotational inertias), measured about the scene's current state;
 /// first-order DOFs (temperature) keep their forward-Euler bound. And the force evaluations

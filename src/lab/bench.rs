@@ -211,7 +211,7 @@ fn run_one(opts: &BenchOptions) -> Result<String, String> {
     let scene = deck::parse(&text, "<bench>", "bench").map_err(|e| e.to_string())?;
     struct Visit<'a>(&'a deck::Scene, &'a BenchOptions);
     impl ModelVisitor for Visit<'_> {
-        type Output = Result<(String, f64), String>;
+        type Output = Result<(String, Medians), String>;
         fn visit<M: Model>(self, model: M) -> Self::Output {
             let setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
             bench_setup(setup, self.1)
@@ -227,23 +227,44 @@ fn run_one(opts: &BenchOptions) -> Result<String, String> {
         out.push_str(&ranks_line(opts, r)?);
     }
     if opts.peer {
-        for &t in &opts.threads {
+        out.push_str(&peer_lines(opts, &ours)?);
+    }
+    Ok(out)
+}
+
+/// µs per particle-step by thread count (medians over rounds).
+type Medians = std::collections::BTreeMap<usize, f64>;
+
+/// The LAMMPS peer at each thread count as that many MPI ranks, `rounds` times, and the ratio
+/// of the medians to PDQ's at the same core count.
+fn peer_lines(opts: &BenchOptions, ours: &Medians) -> Result<String, String> {
+    let mut out = String::new();
+    for &t in &opts.threads {
+        let mut theirs = Vec::new();
+        for _ in 0..opts.rounds.max(1) {
             match peer(opts, t)? {
-                Ok((line, theirs)) => {
+                Ok((line, us)) => {
                     out.push_str(&line);
-                    if t == 1 {
-                        let _ = writeln!(
-                            out,
-                            "bench ratio lammps/pdq={:.2} (model={} vs {}, 1 core each)",
-                            theirs / ours,
-                            bench_name(opts),
-                            peer_style(opts)
-                        );
-                    }
+                    theirs.push(us);
                 }
-                Err(skipped) => out.push_str(&skipped),
+                Err(skipped) => {
+                    out.push_str(&skipped);
+                    return Ok(out);
+                }
             }
         }
+        let (theirs, runs) = (median(theirs.clone()), theirs.len());
+        let _ = writeln!(
+            out,
+            "bench ratio lammps/pdq={:.2} (model={} vs {}, {t} core{} each: {t} thread{} against {t} rank{}; medians of {runs} runs, LAMMPS {theirs:.4} us, PDQ {:.4} us)",
+            theirs / ours.get(&t).copied().unwrap_or(f64::NAN),
+            bench_name(opts),
+            peer_style(opts),
+            if t == 1 { "" } else { "s" },
+            if t == 1 { "" } else { "s" },
+            if t == 1 { "" } else { "s" },
+            ours.get(&t).copied().unwrap_or(f64::NAN),
+        );
     }
     Ok(out)
 }
@@ -410,7 +431,7 @@ fn checkpoint_line<M: Model>(
 fn bench_setup<M: Model>(
     mut setup: setup::Setup<M>,
     opts: &BenchOptions,
-) -> Result<(String, f64), String> {
+) -> Result<(String, Medians), String> {
     let n = setup.sim.particles.n_owned;
     let mut out = String::new();
     if opts.checkpoint {
@@ -476,10 +497,10 @@ fn bench_setup<M: Model>(
             let _ = writeln!(out);
         }
     }
-    let ours = per_count
-        .get(&1)
-        .map(|(us, _)| median(us.clone()))
-        .unwrap_or(f64::NAN);
+    let ours: Medians = per_count
+        .iter()
+        .map(|(&threads, (us, _))| (threads, median(us.clone())))
+        .collect();
     if !opts.yardstick {
         return Ok((out, ours));
     }

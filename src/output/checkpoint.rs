@@ -92,6 +92,11 @@ fn checksum(c: &Checkpoint) -> u64 {
         h.bytes(&b.to_le_bytes());
     }
     h.f64s(&c.state.history);
+    // Absent in runs without a thermostat, whose checksums stay what they were.
+    if let Some(t) = &c.state.thermostat {
+        h.bytes(t.kind.as_bytes());
+        h.f64s(&t.values);
+    }
     h.0
 }
 
@@ -174,6 +179,13 @@ impl Checkpoint {
         b.create_dataset("history")
             .with_f64_data(&self.state.history)
             .with_shape(&[m, lb]);
+        // Optional, so that checkpoints of runs without a thermostat read as before.
+        if let Some(t) = &self.state.thermostat {
+            b.set_attr("thermostat", s(&t.kind));
+            b.create_dataset("thermostat_state")
+                .with_f64_data(&t.values)
+                .with_shape(&[t.values.len() as u64, 1]);
+        }
         // A testing aid (tests/checkpoint.rs kills a run while it writes); not for users.
         let pause = std::env::var("PDQ_CHECKPOINT_PAUSE_MS")
             .ok()
@@ -477,6 +489,7 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
             broken,
             history_pairs,
             history,
+            thermostat: thermostat_state(&f, &a)?,
         },
         scene_hash: attr_u64(&a, "scene_hash")?,
         deck: attr_string(&a, "deck")?,
@@ -489,11 +502,27 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
     Ok(c)
 }
 
-/// The integrator a checkpoint names.
+/// The thermostat's state, in checkpoints of runs that have one.
+fn thermostat_state(
+    f: &hdf5_pure::File,
+    a: &HashMap<String, AttrValue>,
+) -> Result<Option<crate::engine::thermostat::Saved>, String> {
+    let Ok(kind) = attr_string(a, "thermostat") else {
+        return Ok(None);
+    };
+    let unreadable =
+        |e: String| format!("dataset 'thermostat_state' is missing or unreadable ({e})");
+    let values = f
+        .dataset("thermostat_state")
+        .map_err(|e| unreadable(e.to_string()))?
+        .read_f64()
+        .map_err(|e| unreadable(e.to_string()))?;
+    Ok(Some(crate::engine::thermostat::Saved { kind, values }))
+}
+
+/// The integrator a checkpoint names (older ones name the leapfrog "semi-implicit-euler").
 pub fn integrator(name: &str) -> Option<Integrator> {
-    [Integrator::VelocityVerlet, Integrator::SemiImplicitEuler]
-        .into_iter()
-        .find(|i| i.name() == name)
+    Integrator::from_name(name)
 }
 
 /// `pdq info FILE`: what a frame or checkpoint holds.
@@ -566,6 +595,10 @@ mod tests {
                 broken: vec![(0, 2)],
                 history_pairs: vec![(0, 1), (1, 2)],
                 history: vec![1.5e-4, -2.0e-5],
+                thermostat: (step == 20).then(|| crate::engine::thermostat::Saved {
+                    kind: "nose-hoover".into(),
+                    values: vec![0.125, -3.5],
+                }),
             },
             scene_hash: 0x0123_4567_89ab_cdef,
             deck: "beam.toml".into(),

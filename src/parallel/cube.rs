@@ -187,6 +187,7 @@ pub fn build_cube<M: Model>(
     sim.constraints = constraints;
     sim.loads = loads;
     sim.pairs = setup.sim.pairs.as_ref().map(|p| p.fresh());
+    sim.thermostat = setup.sim.thermostat.clone();
     let wall = WallExchange::new(plan.stages.clone(), transport);
     Cube {
         wall,
@@ -267,12 +268,22 @@ impl<M: Model> Cube<M> {
     /// One time step, ghosts exchanged with the neighbours; the bonds that broke in it. Fails
     /// only if a neighbour-list rebuild's shuffle does.
     pub fn advance(&mut self) -> Result<usize, String> {
+        if self.sim.thermostat.is_some() {
+            let mut team = Team::new(self.wall.transport());
+            self.sim
+                .thermostat_begin(&mut |v| team.reduce(v, crate::parallel::comm::Reduce::Sum));
+        }
         self.sim.begin_step();
         if self.sim.pairs.is_some() {
             self.refresh_pairs()?;
         }
         let broken = self.sim.compute_forces_with(&mut self.wall);
         self.sim.end_step();
+        if self.sim.thermostat.is_some() {
+            let mut team = Team::new(self.wall.transport());
+            self.sim
+                .thermostat_end(&mut |v| team.reduce(v, crate::parallel::comm::Reduce::Sum));
+        }
         Ok(broken)
     }
 

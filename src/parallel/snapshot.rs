@@ -34,6 +34,9 @@ pub struct Snapshot {
     /// Bonds with a non-zero history, sorted, and their histories (`Bond::LEN` each).
     pub history_pairs: Vec<(u32, u32)>,
     pub history: Vec<f64>,
+    /// The thermostat's state (Nosé–Hoover's ξ and η, the others' removed energy), if the run
+    /// has one: a restart continues its dynamics, not a fresh thermostat.
+    pub thermostat: Option<crate::engine::thermostat::Saved>,
 }
 
 /// The names and lengths of the alterable and bond-history fields of `M`.
@@ -86,6 +89,8 @@ impl Snapshot {
         }
         let (step, time, dt) = (cube.sim.step, cube.sim.time, cube.sim.dt);
         let integrator = cube.sim.integrator.name().to_string();
+        // Global values, the same on every procCube.
+        let thermostat = cube.sim.thermostat.as_ref().map(|t| t.save());
         let n = cube.global_particles;
         let mut team = cube.team();
         let particles = team.gather(bytemuck::cast_slice(&mine));
@@ -122,6 +127,7 @@ impl Snapshot {
             broken: Vec::new(),
             history_pairs: Vec::new(),
             history: Vec::new(),
+            thermostat,
         };
         for (a, b, broken, h) in rows {
             if broken {
@@ -151,6 +157,9 @@ impl Snapshot {
         }
         sim.time = self.time;
         sim.step = self.step;
+        if let (Some(saved), Some(t)) = (&self.thermostat, &mut sim.thermostat) {
+            t.restore(saved);
+        }
     }
 
     /// Marks the broken bonds of a procCube and sets bond histories, by global ids; sets its

@@ -26,7 +26,7 @@ pub trait Solver<M: Model>: Send {
     }
 }
 
-/// Velocity Verlet or semi-implicit Euler time steps (the scene's integrator), one force
+/// Velocity Verlet or leapfrog time steps (the scene's integrator), one force
 /// evaluation each.
 pub struct Explicit;
 

@@ -94,6 +94,7 @@ impl Converter {
                 "[pair] acts in explicit time stepping only: its neighbour lists follow the particles step by step; remove [solver] or the [pair] section",
             );
         }
+        let thermostat = self.thermostat(deck.thermostat.as_ref(), &names, &time, &solver)?;
         // The names of the periodic axes are checked here, after the sections above, as they
         // always have been, so that a deck with several mistakes still reports the same first.
         let periodic = self.periodic(&deck.lattice)?;
@@ -127,6 +128,7 @@ impl Converter {
             probes,
             solver,
             pair,
+            thermostat,
         })
     }
 

@@ -11,8 +11,9 @@
 //! `[model]` and `[materials]` in `model.rs`, `[lattice]` in `lattice.rs`, `[[geometry]]` and
 //! the shapes of regions in `shape.rs`, `[[bar]]` in `bar.rs`, `[[boundary]]`, `[[load]]` and
 //! `[[initial]]` in `boundary.rs`, `[time]` and `[solver]` in `time.rs`, `[output]` and
-//! `[[probe]]` in `output.rs`, `[parallel]` in `parallel.rs`. A deck in `units = "lj"` is first
-//! searched for values written with units, which it cannot take (`plain.rs`).
+//! `[[probe]]` in `output.rs`, `[parallel]` in `parallel.rs`, `[thermostat]` in
+//! `thermostat.rs`. A deck in `units = "lj"` is first searched for values written with
+//! units, which it cannot take (`plain.rs`).
 
 mod bar;
 mod boundary;
@@ -26,13 +27,14 @@ mod plain;
 mod sections;
 mod shape;
 mod spec;
+mod thermostat;
 mod time;
 
 pub use super::materials::MaterialLines;
 pub use spec::{
     BarSpec, BoundarySpec, Colouring, CriticalStep, InitialSpec, LoadKind, LoadSpec, Located,
     ModelLines, OutputSpec, ParallelSpec, ProbeSpec, Region, RunLength, Scene, SolverSpec,
-    TimeSpec, VelocitySpec,
+    ThermostatKind, ThermostatSpec, TimeSpec, VelocitySpec,
 };
 
 use convert::{Converter, LineIndex};

@@ -43,6 +43,8 @@ pub(super) struct DeckFile {
     pub(super) solver: Option<Spanned<SolverSection>>,
     #[serde(default)]
     pub(super) pair: Option<Spanned<PairSection>>,
+    #[serde(default)]
+    pub(super) thermostat: Option<Spanned<ThermostatSection>>,
     /// What `pdq validate` reads (validation/README.md); a run ignores it.
     #[serde(default, rename = "validation")]
     pub(super) _validation: Option<toml::Table>,
@@ -241,6 +243,21 @@ pub(super) struct VelocitySection {
     pub(super) temperature: f64,
     pub(super) seed: i64,
     pub(super) region: Option<ShapeSpec>,
+}
+
+/// `[thermostat]`: a group's temperature held at a target (MD). Keys keep their spans so that
+/// a bad value is reported at its own line.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ThermostatSection {
+    pub(super) kind: Spanned<String>,
+    /// In kelvin, or in ε/k_B in an lj deck.
+    pub(super) temperature: Spanned<f64>,
+    pub(super) damping: Option<Spanned<Time>>,
+    pub(super) seed: Option<Spanned<i64>>,
+    pub(super) every: Option<Spanned<i64>>,
+    pub(super) region: Option<ShapeSpec>,
+    pub(super) materials: Option<Spanned<Vec<String>>>,
 }
 
 #[derive(Deserialize, Default)]

@@ -145,6 +145,27 @@ pub struct VelocitySpec {
     pub region: Region,
 }
 
+/// `[thermostat]`'s kind and the parameters it takes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ThermostatKind {
+    Rescale { every: u64 },
+    Berendsen { damping: f64 },
+    Langevin { damping: f64, seed: u64 },
+    NoseHoover { damping: f64 },
+}
+
+/// `[thermostat]`: the translational temperature of a group held at `temperature` (the deck's
+/// temperature unit). The group is the particles of `region` whose material is in
+/// `materials` (empty: any).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ThermostatSpec {
+    pub line: usize,
+    pub kind: ThermostatKind,
+    pub temperature: f64,
+    pub region: Region,
+    pub materials: Vec<u16>,
+}
+
 /// How the deck's loads are followed in time.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SolverSpec {
@@ -325,6 +346,8 @@ pub struct Scene {
     pub solver: Located<SolverSpec>,
     /// The non-bonded pair law, if the deck has a `[pair]` section.
     pub pair: Option<PairSpec>,
+    /// `[thermostat]`, if the deck has one.
+    pub thermostat: Option<ThermostatSpec>,
 }
 
 impl Scene {

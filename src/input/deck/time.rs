@@ -60,15 +60,12 @@ impl Converter {
                 )
             }
         };
-        let integrator = match t.integrator.as_deref().unwrap_or("verlet") {
-            "verlet" | "velocity-verlet" => Integrator::VelocityVerlet,
-            "euler" | "semi-implicit-euler" => Integrator::SemiImplicitEuler,
-            other => {
-                return self.err(
-                    line,
-                    format!("[time] unknown integrator '{other}' (use \"verlet\" or \"euler\")"),
-                )
-            }
+        let name = t.integrator.as_deref().unwrap_or("verlet");
+        let Some(integrator) = Integrator::from_name(name) else {
+            return self.err(
+                line,
+                format!("[time] unknown integrator '{name}' (use \"verlet\" or \"leapfrog\")"),
+            );
         };
         Ok(TimeSpec {
             line,

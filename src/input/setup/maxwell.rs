@@ -7,20 +7,7 @@
 //! sums run in global-id order: a particle gets the same velocity bit for bit whatever the
 //! layout or the order the particles are stored in.
 
-use crate::engine::random::splitmix64;
-use std::f64::consts::PI;
-
-/// A standard normal number for component `k` of particle `gid` (Box–Muller on two keyed
-/// uniforms).
-pub(super) fn gaussian(seed: u64, gid: u32, k: usize) -> f64 {
-    let mut h = splitmix64(seed ^ 0x6A09_E667_F3BC_C909);
-    h = splitmix64(h ^ u64::from(gid));
-    h = splitmix64(h ^ k as u64);
-    let uniform = |x: u64| (splitmix64(x) >> 11) as f64 / (1u64 << 53) as f64;
-    // u1 in (0, 1], so its logarithm is finite.
-    let (u1, u2) = (1.0 - uniform(h), uniform(h.wrapping_add(1)));
-    (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
-}
+use crate::engine::random::normal as gaussian;
 
 /// The velocities of particles `gid` of translational masses `mass` (one per component) at
 /// temperature `t`, with Boltzmann's constant `kb` in the deck's units: zero total momentum and

@@ -1,5 +1,5 @@
 //! From a checked deck to a ready-to-step simulation: geometry → particles → bonds → time step
-//! → boundary conditions and loads.
+//! → boundary conditions and loads → thermostat.
 
 use crate::engine::bonds::BondList;
 use crate::engine::cells::CellGrid;
@@ -16,6 +16,7 @@ use std::time::Instant;
 mod maxwell;
 mod pairs;
 mod place;
+mod thermostat;
 mod time_step;
 
 /// A simulation built from a deck, with what the deck's checks found.
@@ -104,6 +105,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     let stepping = time_step::stepping(&mut sim, scene, dt_critical, dt_critical_particle)?;
     let dt = stepping.dt;
     sim.dt = dt;
+    sim.thermostat = thermostat::thermostat(&sim, scene, &gid_to_index)?;
     for c in &sim.constraints {
         c.set_velocity(&mut sim.particles, 0.0, dt);
     }

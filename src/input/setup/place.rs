@@ -9,7 +9,7 @@ use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model};
 
 /// Store indices of the particles of a region, in store order.
-fn select<M: Model>(
+pub(super) fn select<M: Model>(
     p: &Particles<M>,
     region: &Region,
     gid_to_index: &[u32],
