@@ -35,7 +35,8 @@ enum Cmd {
     Models,
     /// Time the standard benchmark scene (shared/bench): µs per particle-step.
     Bench(BenchArgs),
-    /// Plot one history column against another from one or more runs (PNG).
+    /// Plot one column against another from one or more runs' history.csv (or any CSV with a
+    /// header), as lines or points (PNG).
     Plot(PlotArgs),
     /// Write a bondless deck's initial state (positions, velocities, one type per material)
     /// as a LAMMPS data file for `read_data`.
@@ -95,6 +96,9 @@ struct PlotArgs {
     /// The PNG to write.
     #[arg(long)]
     output: PathBuf,
+    /// Draw each row as a point (e.g. every particle of final_positions.csv).
+    #[arg(long)]
+    points: bool,
 }
 
 #[derive(Args)]
@@ -279,6 +283,7 @@ fn plot(a: PlotArgs) -> Result<(), String> {
         labels: a.labels,
         title: a.title,
         output: a.output,
+        points: a.points,
     })
 }
 

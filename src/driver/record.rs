@@ -343,20 +343,25 @@ pub(crate) fn frame_store<M: Model>(setup: Setup<M>) -> FrameStore<M> {
 }
 
 /// Final positions by global id and the broken bonds, at full precision, for comparing runs.
-pub(crate) fn write_final_state(
+fn write_final_state(
     dir: &std::path::Path,
-    position: &[[f64; 3]],
-    damage: &[f64],
+    last: &Final,
     broken: &[(u32, u32)],
 ) -> std::io::Result<()> {
     use std::io::Write;
     let mut f = std::io::BufWriter::new(std::fs::File::create(dir.join("final_positions.csv"))?);
-    writeln!(f, "id,x,y,z,damage")?;
-    for (g, (p, d)) in position.iter().zip(damage).enumerate() {
+    writeln!(f, "id,x,y,z,damage,vx,vy,vz")?;
+    for (g, ((p, d), v)) in last
+        .position
+        .iter()
+        .zip(&last.damage)
+        .zip(&last.velocity)
+        .enumerate()
+    {
         writeln!(
             f,
-            "{g},{:.17e},{:.17e},{:.17e},{:.17e}",
-            p[0], p[1], p[2], d
+            "{g},{:.17e},{:.17e},{:.17e},{:.17e},{:.17e},{:.17e},{:.17e}",
+            p[0], p[1], p[2], d, v[0], v[1], v[2]
         )?;
     }
     f.flush()?;
@@ -452,7 +457,7 @@ pub(crate) fn finish<M: Model>(
     }
     std::fs::write(plan.dir.join("timing.txt"), &timing).map_err(io)?;
     if plan.final_state {
-        write_final_state(&plan.dir, &last.position, &last.damage, &broken_pairs).map_err(io)?;
+        write_final_state(&plan.dir, &last, &broken_pairs).map_err(io)?;
     }
     if let Some(colouring) = plan.picture {
         write_picture(plan, &last, colouring, cube.sim.step, cube.sim.time)?;
@@ -492,18 +497,17 @@ pub(crate) fn finish<M: Model>(
     }))
 }
 
-/// Current positions and damage by global id, on the root (empty elsewhere); with a picture
-/// to draw, also each particle's material and speed.
+/// Current positions, damage, material and velocity by global id, on the root (empty
+/// elsewhere).
 fn final_positions<M: Model>(cube: &mut Cube<M>, n_global: usize) -> Final {
     let damage = cube.damage();
     let p = &cube.sim.particles;
     let mut mine: Vec<f64> = Vec::new();
     for (i, d) in damage.iter().enumerate() {
         let v = p.velocity(i);
-        let speed = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         mine.push(p.gid[i] as f64);
         mine.extend_from_slice(&p.pos(i));
-        mine.extend([*d, p.material[i] as f64, speed]);
+        mine.extend([*d, p.material[i] as f64, v[0], v[1], v[2]]);
     }
     let Some(parts) = cube.team().gather(bytemuck::cast_slice(&mine)) else {
         return Final::default();
@@ -512,15 +516,15 @@ fn final_positions<M: Model>(cube: &mut Cube<M>, n_global: usize) -> Final {
         position: vec![[f64::NAN; 3]; n_global],
         damage: vec![f64::NAN; n_global],
         material: vec![0.0; n_global],
-        speed: vec![0.0; n_global],
+        velocity: vec![[0.0; 3]; n_global],
     };
     for bytes in parts {
-        for rec in f64s(&bytes).chunks_exact(7) {
+        for rec in f64s(&bytes).chunks_exact(9) {
             let id = rec[0] as usize;
             f.position[id] = [rec[1], rec[2], rec[3]];
             f.damage[id] = rec[4];
             f.material[id] = rec[5];
-            f.speed[id] = rec[6];
+            f.velocity[id] = [rec[6], rec[7], rec[8]];
         }
     }
     f
@@ -532,7 +536,7 @@ struct Final {
     position: Vec<[f64; 3]>,
     damage: Vec<f64>,
     material: Vec<f64>,
-    speed: Vec<f64>,
+    velocity: Vec<[f64; 3]>,
 }
 
 /// `picture.png`: the final state from the side and in 3D, coloured as the deck asked.
@@ -565,9 +569,14 @@ fn write_picture(
             (scaled(&f.material, 0.0, last as f64), ends)
         }
         Colouring::Speed => {
-            let (_, hi) = range(&f.speed);
+            let speed: Vec<f64> = f
+                .velocity
+                .iter()
+                .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
+                .collect();
+            let (_, hi) = range(&speed);
             (
-                scaled(&f.speed, 0.0, hi),
+                scaled(&speed, 0.0, hi),
                 ["speed 0".into(), format!("{hi:.3e}")],
             )
         }

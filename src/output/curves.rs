@@ -1,5 +1,6 @@
-//! `pdq plot`: one history column against another, from one or more runs' `history.csv`, as
-//! a PNG (the cyclic bar with and without contact, docs/examples.md).
+//! `pdq plot`: one column against another, from one or more runs' `history.csv` (or any CSV
+//! with a header, such as `final_positions.csv`), as a PNG: lines (the cyclic bar with and
+//! without contact) or points (the channel's velocity profile, docs/examples.md).
 
 use super::plot::{xy, Mark, Series};
 use std::path::{Path, PathBuf};
@@ -66,6 +67,8 @@ pub struct CurvePlot {
     pub labels: Vec<String>,
     pub title: String,
     pub output: PathBuf,
+    /// Draw each row as a point instead of joining rows by lines.
+    pub points: bool,
 }
 
 /// Draws `y` against `x` from every file, one line each.
@@ -99,7 +102,7 @@ pub fn plot_curves(p: &CurvePlot) -> Result<(), String> {
         .map(|(name, points)| Series {
             name,
             points,
-            mark: Mark::Line,
+            mark: if p.points { Mark::Points } else { Mark::Line },
         })
         .collect();
     xy(&p.output, &p.title, &p.x, &p.y, &series)

@@ -1,6 +1,7 @@
 //! Molecular dynamics and the non-bonded pass (issue 23), one test binary: the MD input
 //! (`input`), the thermo against LAMMPS from the same start (`lammps_thermo`), layout
-//! invariance on threads (`layouts`) and the example scenes at a small size (`scenes`).
+//! invariance on threads (`layouts`), the example scenes at a small size (`scenes`) and the
+//! thermostats (`thermostat`).
 
 #[path = "../common/mod.rs"]
 mod common;
@@ -9,3 +10,4 @@ mod input;
 mod lammps_thermo;
 mod layouts;
 mod scenes;
+mod thermostat;

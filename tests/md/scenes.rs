@@ -1,5 +1,6 @@
 //! The example scenes of issue 23 at a small size, each checked for what it is there to show:
-//! the membrane rises where it is pulled, and the cyclic notched bar carries compression through its closed
+//! the membrane rises where it is pulled, the heavy fluid of the Rayleigh–Taylor deck sinks
+//! through the light one, the channel's flow is fastest in the middle, and the cyclic notched bar carries compression through its closed
 //! crack with contact and not without. Each run also draws its picture.
 
 use crate::common::{final_positions, run_quietly};
@@ -80,6 +81,83 @@ fn the_membrane_rises_where_it_is_pulled_and_its_frame_holds() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// The Rayleigh–Taylor deck at 10 × 10 sites across (instead of 20 × 20) with gravity `g`:
+/// the mean height change of the heavy and the light fluid, and the share of heavy atoms that
+/// end below the light fluid's mean height.
+fn rayleigh_taylor(g: &str, name: &str) -> (f64, f64, f64) {
+    let mut text = example("rayleigh_taylor.toml");
+    for (old, new) in [
+        ("max = [23, 23, 27.6]", "max = [11.5, 11.5, 27.6]"),
+        ("max = [23, 23, 13.8]", "max = [11.5, 11.5, 13.8]"),
+        ("max = [23, 23, 25.3]", "max = [11.5, 11.5, 25.3]"),
+        ("gravity = [0, 0, -0.25]", g),
+        (
+            "picture = \"material\"",
+            "picture = \"material\"\nfinal_state = true",
+        ),
+    ] {
+        text = edit(&text, old, new);
+    }
+    let dir = temp(name);
+    let opts = pdq::driver::run::RunOptions {
+        threads: Some(2),
+        ..Default::default()
+    };
+    run_quietly(&text, "rt.toml", &dir, opts).unwrap();
+    let scene = pdq::input::deck::parse(&text, "rt.toml", "rt").unwrap();
+    let setup = pdq::input::setup::build_as::<pdq::models::point::Point>(&scene).unwrap();
+    let p = &setup.sim.particles;
+    let end = final_positions(&dir);
+    let names: Vec<&str> = scene.materials.iter().map(|m| m.name.as_str()).collect();
+    let of = |name: &str| -> Vec<usize> {
+        let m = names.iter().position(|n| *n == name).unwrap() as u16;
+        (0..p.n_owned).filter(|&i| p.material[i] == m).collect()
+    };
+    let now = |i: usize| end[p.gid[i] as usize][2];
+    let mean = |ids: &[usize], z: &dyn Fn(usize) -> f64| {
+        ids.iter().map(|&i| z(i)).sum::<f64>() / ids.len() as f64
+    };
+    let start = |i: usize| p.x0[i][2];
+    let (heavy, light, wall) = (of("heavy"), of("light"), of("wall"));
+    // The walls hold and nothing leaks through them.
+    assert_eq!(mean(&wall, &now), mean(&wall, &start));
+    for &i in heavy.iter().chain(&light) {
+        let z = now(i);
+        assert!(z > 1.725 && z < 25.875, "atom {} at z = {z}", p.gid[i]);
+    }
+    let t = column(&dir, "temperature");
+    assert!(t.iter().all(|t| t.is_finite() && *t > 0.5), "{t:?}");
+    assert_picture(&dir);
+    let light_mean = mean(&light, &now);
+    let below = heavy.iter().filter(|&&i| now(i) < light_mean).count() as f64 / heavy.len() as f64;
+    std::fs::remove_dir_all(&dir).ok();
+    (
+        mean(&heavy, &now) - mean(&heavy, &start),
+        mean(&light, &now) - mean(&light, &start),
+        below,
+    )
+}
+
+#[test]
+fn in_the_rayleigh_taylor_deck_the_heavy_fluid_sinks_through_the_light() {
+    let (heavy, light, below) = rayleigh_taylor("gravity = [0, 0, -0.25]", "rt");
+    // The control: no gravity, the fluids only interdiffuse.
+    let (_, _, mixed) = rayleigh_taylor("gravity = [0, 0, 0]", "rt-control");
+    eprintln!(
+        "mean z moved: heavy {heavy:.3}, light {light:.3}; heavy atoms below the light fluid's mean height: {:.1} % (without gravity {:.1} %)",
+        100.0 * below,
+        100.0 * mixed
+    );
+    assert!(
+        heavy < light,
+        "the heavy fluid sank less ({heavy}) than the light ({light})"
+    );
+    assert!(
+        below > 2.0 * mixed + 0.01,
+        "{below} of the heavy atoms below the light's middle, {mixed} by diffusion alone"
+    );
+}
+
 #[test]
 fn the_cyclic_bar_carries_compression_through_its_crack_only_with_contact() {
     let with = example("notched_bar_cyclic.toml");
@@ -126,4 +204,53 @@ fn the_cyclic_bar_carries_compression_through_its_crack_only_with_contact() {
         "without contact {}",
         mean_push[1]
     );
+}
+
+#[test]
+fn the_channel_flow_has_a_parabolic_profile_and_its_fluid_stays_at_its_temperature() {
+    // The example's first 30 time units (the profile is nearly developed: the viscous time
+    // h²/ν across the half width is about 25).
+    let text = edit(
+        &example("channel_flow.toml"),
+        "duration = 100",
+        "duration = 30",
+    );
+    let dir = temp("channel");
+    run_quietly(&text, "channel.toml", &dir, Default::default()).unwrap();
+    // Mean vx by height from the final state (x, y, z, damage, vx, vy, vz by id).
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(dir.join("final_positions.csv"))
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let mean_vx = |lo: f64, hi: f64| {
+        let v: Vec<f64> = rows
+            .iter()
+            .filter(|r| r[3] >= lo && r[3] < hi)
+            .map(|r| r[5])
+            .collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    // Fluid between z = 1.71 and 17.96; walls below and above.
+    let (near_low, middle, near_high) =
+        (mean_vx(1.5, 4.0), mean_vx(7.0, 12.5), mean_vx(15.5, 18.5));
+    // The wall sites are at z = 0 and 0.855 (a fluid atom in a hollow of the wall comes to 1.4).
+    let wall = mean_vx(-1.0, 1.0);
+    eprintln!("mean vx: near the floor {near_low:.3}, middle {middle:.3}, near the ceiling {near_high:.3}");
+    assert_eq!(wall, 0.0, "the walls moved");
+    assert!(middle > 0.4, "the middle flows at {middle}");
+    for near in [near_low, near_high] {
+        assert!(
+            near < 0.5 * middle,
+            "near a wall {near} against {middle} in the middle"
+        );
+    }
+    // The thermostat holds the fluid near T = 1 (its temperature counts the flow too).
+    let t = column(&dir, "temperature");
+    let late: Vec<f64> = t[t.len() / 3..].to_vec();
+    let mean = late.iter().sum::<f64>() / late.len() as f64;
+    assert!((mean - 1.0).abs() < 0.1, "temperature {mean}");
+    assert_picture(&dir);
+    std::fs::remove_dir_all(&dir).ok();
 }

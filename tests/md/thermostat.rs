@@ -10,8 +10,6 @@ use pdq::parallel;
 use pdq::parallel::decomposition::{Procs, Walls};
 use std::path::PathBuf;
 
-mod common;
-
 /// 500 LJ atoms: 5³ fcc cells at ρ* = 0.8442 in a periodic box, LJ cut at 2.5σ and shifted (so
 /// that the energy has no jumps at the cutoff), Maxwell–Boltzmann start at `t_start`.
 fn lj_deck(t_start: f64, steps: u64, extra: &str) -> String {
@@ -175,7 +173,7 @@ fn berendsen_and_rescale_reach_their_target_and_count_what_they_take() {
         1000,
         "history_every = 1\n[thermostat]\nkind = \"berendsen\"\ntemperature = 1.5\ndamping = 0.1\n",
     );
-    common::run_quietly(&text, "b.toml", &dir, RunOptions::default()).unwrap();
+    crate::common::run_quietly(&text, "b.toml", &dir, RunOptions::default()).unwrap();
     let history = std::fs::read_to_string(dir.join("history.csv")).unwrap();
     let rows: Vec<Vec<f64>> = history
         .lines()
@@ -334,13 +332,13 @@ fn out_dir(name: &str) -> PathBuf {
 /// returns the two output directories and the thermostat state of the step-200 checkpoint.
 fn straight_and_restarted(text: &str, name: &str) -> (PathBuf, PathBuf, Vec<f64>) {
     let straight = out_dir(&format!("{name}-straight"));
-    common::run_quietly(text, "nh.toml", &straight, RunOptions::default()).unwrap();
+    crate::common::run_quietly(text, "nh.toml", &straight, RunOptions::default()).unwrap();
     let resumed = out_dir(&format!("{name}-resumed"));
     let first = RunOptions {
         steps: Some(200),
         ..Default::default()
     };
-    common::run_quietly(text, "nh.toml", &resumed, first).unwrap();
+    crate::common::run_quietly(text, "nh.toml", &resumed, first).unwrap();
     let at = resumed.join("checkpoints/checkpoint_00000200.h5");
     let c = pdq::output::checkpoint::Checkpoint::read(&at).unwrap();
     let saved = c
@@ -352,7 +350,7 @@ fn straight_and_restarted(text: &str, name: &str) -> (PathBuf, PathBuf, Vec<f64>
         restart: Some(resumed.join("checkpoints")),
         ..Default::default()
     };
-    common::run_quietly(text, "nh.toml", &resumed, restart).unwrap();
+    crate::common::run_quietly(text, "nh.toml", &resumed, restart).unwrap();
     (straight, resumed, saved.values)
 }
 
