@@ -423,16 +423,7 @@ fn a_nose_hoover_lj_restart_continues_to_round_off() {
         history == read(&resumed, "history.csv"),
         "history.csv differs"
     );
-    let positions = |d: &PathBuf| -> Vec<[f64; 3]> {
-        read(d, "final_positions.csv")
-            .lines()
-            .skip(1)
-            .map(|l| {
-                let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-                [v[1], v[2], v[3]]
-            })
-            .collect()
-    };
+    let positions = |d: &PathBuf| crate::common::final_positions(d);
     let period = 5.0 * (4.0f64 / 0.8442).cbrt();
     let (a, b) = (positions(&straight), positions(&resumed));
     let (dx, _) = differences(&(a, vec![]), &(b, vec![]), period);
