@@ -452,6 +452,14 @@ pub(crate) fn finish<M: Model>(
             String::new()
         }
     );
+    if cube.sim.pairs.is_some() {
+        let [migrated, shuffled] = cube.rebuilds;
+        let _ = writeln!(
+            timing,
+            "neighbour lists: {} rebuilds ({migrated} by migration, {shuffled} by shuffle)",
+            migrated + shuffled
+        );
+    }
     if balance.len() > 1 {
         timing.push_str(&balance_table(&balance, steps));
     }

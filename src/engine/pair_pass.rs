@@ -74,6 +74,12 @@ pub struct PairPass<L: PairLaw> {
     bonded: Vec<(u32, u32)>,
     mark: Vec<u32>,
     mark_bond: Vec<u32>,
+    /// Scratch of the build: held positions by coordinate, and one particle's candidates.
+    packed: [Vec<f64>; 3],
+    found: Vec<u32>,
+    /// Scratch of the sweep: one particle's pairs within the cutoff (as many slots as the
+    /// longest row of the list).
+    near: Vec<Near>,
     tally: PairTally,
     builds: u64,
     /// The material of every particle at the last build, if there is only one.
@@ -94,6 +100,9 @@ impl<L: PairLaw> PairPass<L> {
             bonded: Vec::new(),
             mark: Vec::new(),
             mark_bond: Vec::new(),
+            packed: Default::default(),
+            found: Vec::new(),
+            near: Vec::new(),
             tally: PairTally::default(),
             builds: 0,
             single: None,
@@ -106,18 +115,24 @@ impl<L: PairLaw> PairPass<L> {
     }
 
     /// Every listed pair's force on both ends; with `SKIP`, not while the pair's bond is intact.
+    /// The pairs of a particle within the law's largest cutoff are picked first, without a
+    /// branch, and only they are evaluated: listed pairs fall on either side of the cutoff
+    /// unpredictably (the skin holds about a third of them), and a mispredicted branch per
+    /// pair would cost more than the force.
     fn sweep<M: Model, const SKIP: bool>(
-        &self,
+        &mut self,
         p: &mut Particles<M>,
         broken: &[bool],
     ) -> PairTally {
         let single = self.single;
+        let cut2 = self.law.cutoff() * self.law.cutoff();
         let mut t = PairTally::default();
+        let near = &mut self.near;
         for i in 0..p.n_owned {
             let xi = pos(p, i);
             let mi = p.material[i];
-            let mut fi = [0.0; 3];
             let listed = self.offsets[i] as usize..self.offsets[i + 1] as usize;
+            let mut m = 0;
             for (k, &j) in listed.clone().zip(&self.partner[listed]) {
                 if SKIP {
                     let b = self.bond_of[k];
@@ -125,12 +140,17 @@ impl<L: PairLaw> PairPass<L> {
                         continue;
                     }
                 }
-                let j = j as usize;
-                let xj = pos(p, j);
+                let xj = pos(p, j as usize);
                 let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
                 let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                near[m] = Near { j, d, r2 };
+                m += (r2 < cut2) as usize;
+            }
+            let mut fi = [0.0; 3];
+            for &Near { j, d, r2 } in &near[..m] {
+                let j = j as usize;
                 let c = match single {
-                    Some(m) => self.law.coeff(m, m),
+                    Some(s) => self.law.coeff(s, s),
                     None => self.law.coeff(mi, p.material[j]),
                 };
                 let vv = if L::VOLUMES {
@@ -157,6 +177,29 @@ impl<L: PairLaw> PairPass<L> {
             }
         }
         t
+    }
+
+    /// Appends owned particle `i`'s partners (`found`) to the list, with the bond joining each
+    /// when bonded pairs are skipped.
+    fn list(&mut self, i: usize) {
+        self.partner.extend_from_slice(&self.found);
+        if self.skip_bonded {
+            let s = self.bonded_start[i] as usize..self.bonded_start[i + 1] as usize;
+            for &(j, k) in &self.bonded[s] {
+                self.mark[j as usize] = i as u32;
+                self.mark_bond[j as usize] = k;
+            }
+            let (mark, mark_bond) = (&self.mark, &self.mark_bond);
+            self.bond_of.extend(self.found.iter().map(|&j| {
+                let bonded = mark[j as usize] == i as u32;
+                if bonded {
+                    mark_bond[j as usize]
+                } else {
+                    NO_BOND
+                }
+            }));
+        }
+        self.offsets[i + 1] = self.partner.len() as u32;
     }
 
     /// Every intact bond's two ends, as lists per particle (owned and ghost).
@@ -197,6 +240,14 @@ fn pos<M: Model>(p: &Particles<M>, i: usize) -> [f64; 3] {
     [a[0], a[1], a[2]]
 }
 
+/// A listed pair in the sweep: the partner, x_j − x_i and its square length.
+#[derive(Clone, Copy, Debug, Default)]
+struct Near {
+    j: u32,
+    d: [f64; 3],
+    r2: f64,
+}
+
 /// No bond joins the pair.
 const NO_BOND: u32 = u32::MAX;
 
@@ -233,56 +284,55 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
             self.index_bonds(n, bonds);
         }
         let reach = <Self as NonBonded<M>>::reach(self);
-        let r2max = reach * reach;
         self.single = single_material(&p.material);
-        let PairPass {
-            offsets,
-            partner,
-            bond_of,
-            mark,
-            mark_bond,
-            bonded_start,
-            bonded,
-            skip_bonded,
-            ..
-        } = self;
-        let skip = *skip_bonded;
-        offsets.clear();
-        offsets.resize(p.n_owned + 1, 0);
-        partner.clear();
-        bond_of.clear();
+        // Coordinates apart and contiguous, so that the distance test runs in vector lanes.
+        for (a, xs) in self.packed.iter_mut().enumerate() {
+            xs.clear();
+            xs.extend((0..n).map(|i| p.alter[i].as_slice()[a]));
+        }
+        self.offsets.clear();
+        self.offsets.resize(p.n_owned + 1, 0);
+        self.partner.clear();
+        self.bond_of.clear();
+        let mut runs: Vec<Range<usize>> = Vec::with_capacity(14);
         for (k, shell) in cells.half_shell.iter().enumerate() {
             let own = cells.cell_range[k].clone();
+            // The half shell's cells as runs of the store: neighbours along a row of cells
+            // are usually adjacent there, and longer runs fill the vector lanes better.
+            runs.clear();
+            runs.extend(
+                shell
+                    .iter()
+                    .filter(|&&q| q != u32::MAX)
+                    .map(|&q| cells.cell_range[q as usize].clone())
+                    .filter(|r| !r.is_empty()),
+            );
+            runs.sort_unstable_by_key(|r| r.start);
+            merge_runs(&mut runs);
+            // The run that continues this cell, if any, is scanned with its rest.
+            let after = runs.iter().position(|r| r.start == own.end);
             for i in own.clone() {
-                let xi = pos(p, i);
-                if skip {
-                    let s = bonded_start[i] as usize..bonded_start[i + 1] as usize;
-                    for &(j, k) in &bonded[s] {
-                        mark[j as usize] = i as u32;
-                        mark_bond[j as usize] = k;
+                self.found.clear();
+                let mut rest = i + 1..own.end;
+                if let Some(a) = after {
+                    rest.end = runs[a].end;
+                }
+                within(&self.packed, i, rest, reach, &mut self.found);
+                for (n, r) in runs.iter().enumerate() {
+                    if Some(n) != after {
+                        within(&self.packed, i, r.clone(), reach, &mut self.found);
                     }
                 }
-                let mut visit = |j: usize| {
-                    let xj = pos(p, j);
-                    let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
-                    let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                    if r2 < r2max {
-                        partner.push(j as u32);
-                        let bonded = skip && mark[j] == i as u32;
-                        bond_of.push(if bonded { mark_bond[j] } else { NO_BOND });
-                    }
-                };
-                for j in i + 1..own.end {
-                    visit(j);
-                }
-                for &q in shell.iter().filter(|&&q| q != u32::MAX) {
-                    for j in cells.cell_range[q as usize].clone() {
-                        visit(j);
-                    }
-                }
-                offsets[i + 1] = partner.len() as u32;
+                self.list(i);
             }
         }
+        let longest = self
+            .offsets
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .max()
+            .unwrap_or(0);
+        self.near.resize(longest as usize, Near::default());
         self.at_build.clear();
         self.at_build.extend((0..p.n_owned).map(|i| pos(p, i)));
         self.builds += 1;
@@ -311,6 +361,50 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
     fn fresh(&self) -> Box<dyn NonBonded<M>> {
         Box::new(PairPass::new(self.law.clone(), self.skin, self.skip_bonded))
     }
+}
+
+/// Appends to `found` the particles of `range` closer to particle `i` than `reach`. The
+/// distances of a block are computed first and the hits written without a branch: most
+/// candidates miss, and a branch per candidate would be mispredicted at every hit.
+fn within(xs: &[Vec<f64>; 3], i: usize, range: Range<usize>, reach: f64, found: &mut Vec<u32>) {
+    const BLOCK: usize = 32;
+    let r2max = reach * reach;
+    let xi = [xs[0][i], xs[1][i], xs[2][i]];
+    let mut start = range.start;
+    while start < range.end {
+        let len = BLOCK.min(range.end - start);
+        let (x, y, z) = (
+            &xs[0][start..start + len],
+            &xs[1][start..start + len],
+            &xs[2][start..start + len],
+        );
+        let mut hits = 0u32;
+        for t in 0..len {
+            let d = [x[t] - xi[0], y[t] - xi[1], z[t] - xi[2]];
+            let hit = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < r2max;
+            hits |= (hit as u32) << t;
+        }
+        // Only the hits cost from here on.
+        while hits != 0 {
+            found.push(start as u32 + hits.trailing_zeros());
+            hits &= hits - 1;
+        }
+        start += len;
+    }
+}
+
+/// Joins runs (sorted by start) that follow one another.
+fn merge_runs(runs: &mut Vec<Range<usize>>) {
+    let mut kept = 0;
+    for n in 0..runs.len() {
+        if kept > 0 && runs[kept - 1].end == runs[n].start {
+            runs[kept - 1].end = runs[n].end;
+        } else {
+            runs[kept] = runs[n].clone();
+            kept += 1;
+        }
+    }
+    runs.truncate(kept);
 }
 
 /// The material of every particle, if there is only one.

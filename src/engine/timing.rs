@@ -9,8 +9,11 @@ pub enum Phase {
     Setup,
     State,
     Forces,
-    /// The non-bonded pass and its neighbour-list builds.
+    /// The non-bonded pass.
     Pairs,
+    /// Deciding when to rebuild the neighbour lists, moving particles to the procCubes of their
+    /// current cells, and building the lists.
+    Neighbours,
     Communication,
     Boundary,
     Integration,
@@ -18,11 +21,12 @@ pub enum Phase {
 }
 
 impl Phase {
-    pub const ALL: [Phase; 8] = [
+    pub const ALL: [Phase; 9] = [
         Phase::Setup,
         Phase::State,
         Phase::Forces,
         Phase::Pairs,
+        Phase::Neighbours,
         Phase::Communication,
         Phase::Boundary,
         Phase::Integration,
@@ -35,6 +39,7 @@ impl Phase {
             Phase::State => "state pass",
             Phase::Forces => "forces",
             Phase::Pairs => "pair forces",
+            Phase::Neighbours => "neighbour lists",
             Phase::Communication => "communication",
             Phase::Boundary => "boundary/loads",
             Phase::Integration => "integration",
@@ -45,7 +50,7 @@ impl Phase {
 
 #[derive(Clone, Debug, Default)]
 pub struct Timing {
-    spent: [Duration; 8],
+    spent: [Duration; 9],
 }
 
 impl Timing {

@@ -37,6 +37,9 @@ pub struct Cube<M: Model> {
     pub lost: Vec<u32>,
     /// Those bonds as (smaller, larger) global ids, kept by the owner of the smaller.
     pub dropped: Vec<(u32, u32)>,
+    /// Neighbour-list rebuilds that moved particles by migration, and by a shuffle (the same
+    /// on every worker: the choice is collective).
+    pub rebuilds: [u64; 2],
 }
 
 /// Boundary conditions, loads and probes of the whole scene, by global id.
@@ -48,6 +51,11 @@ pub(crate) struct Everywhere {
 }
 
 impl Everywhere {
+    /// Whether the scene has no boundary conditions, loads or probes at all.
+    pub fn is_empty(&self) -> bool {
+        self.constraints.is_empty() && self.loads.is_empty() && self.probes.is_empty()
+    }
+
     fn of<M: Model>(setup: &Setup<M>) -> Everywhere {
         let gid = &setup.sim.particles.gid;
         let by_gid = |list: &[u32]| list.iter().map(|&i| gid[i as usize]).collect();
@@ -199,6 +207,7 @@ pub fn build_cube<M: Model>(
         global_particles: g.len(),
         everywhere,
         dropped: Vec::new(),
+        rebuilds: [0; 2],
     }
 }
 
@@ -299,10 +308,12 @@ impl<M: Model> Cube<M> {
             .as_ref()
             .is_some_and(|pairs| pairs.moved_too_far(&self.sim.particles));
         if self.team().max(if far { 1.0 } else { 0.0 }) > 0.0 {
-            // The shuffle builds the lists from the redrawn cells.
-            self.shuffle_now()?;
+            // Particles go to the cells of their current positions; the lists are built there.
+            self.rebin()?;
         }
-        self.sim.timing.lap(crate::engine::timing::Phase::Pairs, t);
+        self.sim
+            .timing
+            .lap(crate::engine::timing::Phase::Neighbours, t);
         Ok(())
     }
 

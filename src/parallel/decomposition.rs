@@ -204,7 +204,13 @@ impl Layout {
 
     /// The procCube next to `k` along `axis` in direction `dir`, and the periods a cell
     /// coordinate gains on the way (wrapping around a periodic axis).
-    fn neighbour(&self, k: usize, axis: usize, dir: i64, periodic: bool) -> Option<(usize, i64)> {
+    pub fn neighbour(
+        &self,
+        k: usize,
+        axis: usize,
+        dir: i64,
+        periodic: bool,
+    ) -> Option<(usize, i64)> {
         let mut c = self.coords(k);
         let p = self.procs[axis] as i64;
         let v = c[axis] as i64 + dir;
@@ -501,30 +507,51 @@ pub struct CubePlan {
     pub stages: Vec<Stage>,
 }
 
-/// The particle-level plan of procCube `rank`.
+/// The particle-level plan of procCube `rank`, from the layout's binning of the scene.
 pub fn cube_plan(layout: &Layout, plans: &[CellPlan], rank: usize) -> CubePlan {
-    let (domain, cell_start, order) = (&layout.domain, &layout.start, &layout.order);
+    let (cell_start, order) = (&layout.start, &layout.order);
     let plan = &plans[rank];
-    let ranges = |p: &CellPlan| -> Vec<Range<usize>> {
-        let mut next = 0;
-        p.held
-            .iter()
-            .map(|h| {
-                let n = (cell_start[h.cell + 1] - cell_start[h.cell]) as usize;
-                next += n;
-                next - n..next
-            })
-            .collect()
-    };
-    let cell_range = ranges(plan);
-    let mut global = Vec::new();
-    let mut shift = Vec::new();
-    for h in &plan.held {
-        let s = [0, 1, 2].map(|a| h.wraps[a] as f64 * domain.period[a]);
-        for &g in &order[cell_start[h.cell] as usize..cell_start[h.cell + 1] as usize] {
-            global.push(g);
-            shift.push(s);
-        }
+    let counts: Vec<u32> = plan
+        .held
+        .iter()
+        .map(|h| cell_start[h.cell + 1] - cell_start[h.cell])
+        .collect();
+    let global = plan
+        .held
+        .iter()
+        .flat_map(|h| order[cell_start[h.cell] as usize..cell_start[h.cell + 1] as usize].iter())
+        .copied()
+        .collect();
+    particle_plan(rank, plan, &counts, global, layout.domain.period)
+}
+
+/// The particle-level plan of a procCube whose held cells hold `counts` particles each, with
+/// `global` the ids of its particles in store order (held cell by held cell). Particles of a
+/// cell are contiguous, so every message is a list of cell runs.
+pub fn particle_plan(
+    rank: usize,
+    plan: &CellPlan,
+    counts: &[u32],
+    global: Vec<u32>,
+    period: [f64; 3],
+) -> CubePlan {
+    let mut next = 0;
+    let cell_range: Vec<Range<usize>> = counts
+        .iter()
+        .map(|&n| {
+            next += n as usize;
+            next - n as usize..next
+        })
+        .collect();
+    debug_assert_eq!(
+        next,
+        global.len(),
+        "cell counts disagree with the particles"
+    );
+    let mut shift = Vec::with_capacity(global.len());
+    for (h, r) in plan.held.iter().zip(&cell_range) {
+        let s = [0, 1, 2].map(|a| h.wraps[a] as f64 * period[a]);
+        shift.extend(std::iter::repeat_n(s, r.len()));
     }
     let n_owned = cell_range
         .get(plan.owned_cells.wrapping_sub(1))
@@ -551,7 +578,7 @@ pub fn cube_plan(layout: &Layout, plans: &[CellPlan], rank: usize) -> CubePlan {
                 send,
                 from: st.from,
                 recv,
-                shift: [0, 1, 2].map(|a| st.wraps[a] as f64 * domain.period[a]),
+                shift: [0, 1, 2].map(|a| st.wraps[a] as f64 * period[a]),
             }
         })
         .collect();
@@ -564,6 +591,32 @@ pub fn cube_plan(layout: &Layout, plans: &[CellPlan], rank: usize) -> CubePlan {
         cells: plan.clone(),
         cell_range,
         stages,
+    }
+}
+
+impl CellPlan {
+    /// The five messages at the level of cells: held cell indices sent, held cells received.
+    /// Forwarding per-cell values along them gives every procCube its ghost cells' values.
+    pub fn cell_stages(&self) -> Vec<Stage> {
+        self.stages
+            .iter()
+            .map(|st| Stage {
+                to: st.to,
+                send: st.send.iter().map(|&c| c as u32).collect(),
+                from: st.from,
+                recv: st.recv.clone(),
+                shift: [0.0; 3],
+            })
+            .collect()
+    }
+
+    /// Index among the held cells of the owned cell at grid coordinates `at`.
+    pub fn owned_index(&self, at: [usize; 3]) -> usize {
+        let (lo, hi) = (self.lo, self.hi);
+        let [nx, _, nz] = [0, 1, 2].map(|a| (hi[a] - lo[a]) as usize);
+        let [x, y, z] = [0, 1, 2].map(|a| at[a] - lo[a] as usize);
+        // Owned cells are held y slowest, then z, then x (see `cell_plans`).
+        (y * nz + z) * nx + x
     }
 }
 

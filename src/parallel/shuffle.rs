@@ -17,6 +17,7 @@
 
 use crate::engine::bonds::BondList;
 use crate::engine::cells::HALF_SHELL;
+use crate::engine::particles::Particles;
 use crate::model::attributes::Attributes;
 use crate::model::{BondGeom, Model};
 use crate::parallel::comm::f64s;
@@ -122,11 +123,33 @@ impl<M: Model> Cube<M> {
             .collect();
         self.lost = (0..plan.n_owned).map(|l| whole.lost[g(l)]).collect();
 
-        let mut local = vec![u32::MAX; n];
-        for l in 0..plan.n_owned {
-            local[g(l)] = l as u32;
+        self.install(part, list, plan);
+        self.layout = layout;
+        // Ghosts came current from the whole scene, forces with their particles. The neighbour
+        // lists held the old local indices: they are built again here.
+        if self.sim.pairs.is_some() {
+            self.build_pair_list();
         }
-        let (mut constraints, loads, probes) = self.everywhere.share(&local);
+        Ok(())
+    }
+
+    /// Puts new particles, bonds and plan in place of the old, with this procCube's share of
+    /// the boundary conditions, loads and probes found again by global id.
+    pub(crate) fn install(
+        &mut self,
+        part: Particles<M>,
+        list: BondList<M::Bond>,
+        plan: crate::parallel::decomposition::CubePlan,
+    ) {
+        let (mut constraints, loads, probes) = if self.everywhere.is_empty() {
+            (Vec::new(), Vec::new(), Vec::new())
+        } else {
+            let mut local = vec![u32::MAX; self.global_particles];
+            for l in 0..plan.n_owned {
+                local[plan.global[l] as usize] = l as u32;
+            }
+            self.everywhere.share(&local)
+        };
         // Reactions are reported before the next force evaluation: each procCube keeps its
         // share (the sum over procCubes is what the history shows).
         for (new, old) in constraints.iter_mut().zip(&self.sim.constraints) {
@@ -139,13 +162,6 @@ impl<M: Model> Cube<M> {
         self.probes = probes;
         self.wall.set_stages(plan.stages.clone());
         self.plan = plan;
-        self.layout = layout;
-        // Ghosts came current from the whole scene, forces with their particles. The neighbour
-        // lists held the old local indices: they are built again here.
-        if self.sim.pairs.is_some() {
-            self.build_pair_list();
-        }
-        Ok(())
     }
 
     /// This procCube's owned particles and bonds as f64 records: counts (particles, bonds,
@@ -381,7 +397,10 @@ fn pos_of<M: Model>(a: &M::Alter) -> [f64; 3] {
 }
 
 /// A position moved into the periodic box, and the shift taken off.
-fn wrap(p: [f64; 3], d: &crate::parallel::decomposition::Domain) -> ([f64; 3], [f64; 3]) {
+pub(crate) fn wrap(
+    p: [f64; 3],
+    d: &crate::parallel::decomposition::Domain,
+) -> ([f64; 3], [f64; 3]) {
     let mut w = p;
     let mut shift = [0.0; 3];
     for a in 0..3 {

@@ -1,5 +1,6 @@
 //! Layout invariance of the non-bonded pass (issue 23): the LJ melt over 200 steps, its
-//! neighbour lists rebuilt (with a shuffle) as atoms move and a shuffle every 10 steps besides,
+//! neighbour lists rebuilt (atoms migrating to their new procCubes) as atoms move and a
+//! shuffle every 10 steps besides,
 //! follows the same trajectory to round-off on 1, 2 and 4 procCubes on threads (the MPI ranks'
 //! version is in tests/mpi_runs.rs).
 
@@ -31,6 +32,20 @@ fn the_lj_melt_is_the_same_on_1_2_and_4_threads() {
         let d = max_distance(&reference, &final_positions(&dir), period);
         eprintln!("{threads} threads {procs:?}: positions within {d:.2e} of one thread's");
         assert!(d < 1e-9, "{procs:?}: positions differ by {d:e}");
+        // Every rebuild moved atoms to their new procCubes by migration, not by a shuffle.
+        let timing = std::fs::read_to_string(dir.join("timing.txt")).unwrap();
+        let line = timing
+            .lines()
+            .find(|l| l.starts_with("neighbour lists:"))
+            .unwrap_or_else(|| panic!("no neighbour-list line in timing.txt:\n{timing}"));
+        let numbers: Vec<u64> = line
+            .split(|c: char| !c.is_ascii_digit())
+            .filter_map(|w| w.parse().ok())
+            .collect();
+        assert!(
+            numbers.len() == 3 && numbers[1] > 0 && numbers[1] == numbers[0],
+            "{procs:?}: {line}"
+        );
         let other = std::fs::read_to_string(dir.join("history.csv")).unwrap();
         assert_eq!(other.lines().count(), history.lines().count());
     }
