@@ -38,6 +38,16 @@ enum Cmd {
     /// Plot one column against another from one or more runs' history.csv (or any CSV with a
     /// header), as lines or points (PNG).
     Plot(PlotArgs),
+    /// Draw a run's pictures again from its output directory: the history (energies, broken
+    /// bonds, grips, probes, temperature and pressure) into DIR/pictures/, and the final state
+    /// coloured by damage (or speed, if nothing broke) as DIR/pictures/body.png when the run
+    /// wrote final_positions.csv.
+    Pictures {
+        dir: PathBuf,
+        /// The title over each picture (default: the directory's name).
+        #[arg(long)]
+        title: Option<String>,
+    },
     /// Write a bondless deck's initial state (positions, velocities, one type per material)
     /// as a LAMMPS data file for `read_data`.
     LammpsData {
@@ -243,6 +253,18 @@ fn main() -> ExitCode {
                 false
             }),
         Cmd::Plot(a) => plot(a).map(|()| false),
+        Cmd::Pictures { dir, title } => {
+            let title = title.unwrap_or_else(|| {
+                dir.file_name()
+                    .map_or_else(|| dir.display().to_string(), |d| d.to_string_lossy().into())
+            });
+            pdq::output::pictures::redraw(&dir, &title).map(|files| {
+                for f in files {
+                    println!("{}", f.display());
+                }
+                false
+            })
+        }
         Cmd::LammpsData { deck: path, output } => deck::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| pdq::driver::export::lammps_data(&scene))

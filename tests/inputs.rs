@@ -64,6 +64,45 @@ fn quick_example_runs_and_cracks() {
     }
     assert_eq!(history.lines().count(), 1 + 1 + 2000 / 20);
     assert!(dir.join("frames.xdmf").exists() && dir.join("timing.txt").exists());
+    // The grip moves at 0.5 m/s after a 5 µs ramp: its mean displacement is that motion.
+    let names: Vec<&str> = header.split(',').collect();
+    let last: Vec<f64> = history
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let at = |name: &str| last[names.iter().position(|&c| c == name).unwrap()];
+    let expected = 0.5 * (at("time") - 2.5e-6);
+    let moved = at("displacement_grip_right_x");
+    assert!(
+        (moved - expected).abs() < 1e-3 * expected,
+        "grip moved {moved}, expected {expected}"
+    );
+    assert_eq!(at("displacement_grip_left_x"), 0.0);
+    // Every run leaves its pictures; `pdq pictures` draws the same again.
+    let pictures = [
+        "energy.png",
+        "broken_bonds.png",
+        "load_displacement_grip_right_x.png",
+        "reaction_grip_left_x.png",
+        "probe_tip.png",
+    ];
+    for p in pictures {
+        let file = dir.join("pictures").join(p);
+        let bytes = std::fs::read(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        assert!(bytes.starts_with(b"\x89PNG") && bytes.len() > 10_000, "{p}");
+    }
+    assert!(dir.join("picture.png").exists(), "the damage picture");
+    std::fs::remove_dir_all(dir.join("pictures")).unwrap();
+    let again = pdq::output::pictures::redraw(&dir, "again").unwrap();
+    for p in pictures {
+        assert!(
+            again.contains(&dir.join("pictures").join(p)),
+            "{p} not redrawn"
+        );
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }
 

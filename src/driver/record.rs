@@ -51,6 +51,11 @@ pub(crate) fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
             c.push(format!("reaction_{}_{}", b.name, dof_name::<M>(d)));
         }
     }
+    for b in &setup.sim.constraints {
+        for d in b.dofs.iter().filter(|&&d| d < 3) {
+            c.push(format!("displacement_{}_{}", b.name, dof_name::<M>(*d)));
+        }
+    }
     for (name, _) in &setup.probes {
         for k in ["ux", "uy", "uz"] {
             c.push(format!("{name}_{k}"));
@@ -106,6 +111,9 @@ pub(crate) struct Row {
     pub loads: Vec<f64>,
     /// Each constraint's reaction on each of its DOFs, in deck order.
     pub reactions: Vec<f64>,
+    /// Each constraint's mean displacement along each of its translational DOFs, in deck
+    /// order: with the reaction, the load–displacement curve of a grip.
+    pub grips: Vec<f64>,
     /// Each probe's displacement, in deck order.
     pub probes: Vec<[f64; 3]>,
     /// √(Σ F²) over the free second-order DOFs: how far from equilibrium.
@@ -137,6 +145,7 @@ impl Row {
         }
         v.extend_from_slice(&self.loads);
         v.extend_from_slice(&self.reactions);
+        v.extend_from_slice(&self.grips);
         v.extend(self.probes.iter().flatten());
         v.push(self.residual_force);
         if let Some((iterations, residual)) = self.solve {
@@ -167,6 +176,8 @@ impl Row {
         for b in &sim.constraints {
             sums.extend_from_slice(&b.reaction);
         }
+        let first_grip = sums.len();
+        sums.extend(grip_sums(&sim.constraints, &sim.particles));
         let first_probe = sums.len();
         sums.resize(first_probe + 3 * n_probes, 0.0);
         for &(k, i) in &cube.probes {
@@ -201,7 +212,8 @@ impl Row {
             broken_bonds: sums[2] as u64,
             max_damage,
             loads: sums[3..3 + n_loads].to_vec(),
-            reactions: sums[3 + n_loads..first_probe].to_vec(),
+            reactions: sums[3 + n_loads..first_grip].to_vec(),
+            grips: grip_means(&cube.sim.constraints, &sums[first_grip..first_probe]),
             probes,
             residual_force: sums[first_probe + 3 * n_probes].sqrt(),
             pairs: pairs.map(|_| {
@@ -214,6 +226,46 @@ impl Row {
             reservoir: cube.sim.thermostat.as_ref().map(|t| t.reservoir()),
         }
     }
+}
+
+/// For each constraint, its owned particles' count and then their summed displacement along
+/// each translational DOF it holds (summed over procCubes before [`grip_means`]).
+fn grip_sums<M: Model>(
+    constraints: &[crate::engine::boundary::Constraint],
+    p: &Particles<M>,
+) -> Vec<f64> {
+    let mut sums = Vec::new();
+    for b in constraints {
+        sums.push(b.particles.len() as f64);
+        for &d in b.dofs.iter().filter(|&&d| d < 3) {
+            sums.push(
+                b.particles
+                    .iter()
+                    .map(|&i| p.displacement(i as usize)[d])
+                    .sum(),
+            );
+        }
+    }
+    sums
+}
+
+/// Mean displacements from [`grip_sums`] summed over procCubes (0 for an empty constraint).
+fn grip_means(constraints: &[crate::engine::boundary::Constraint], sums: &[f64]) -> Vec<f64> {
+    let mut means = Vec::new();
+    let mut at = 0;
+    for b in constraints {
+        let count = sums[at];
+        let n = b.dofs.iter().filter(|&&d| d < 3).count();
+        means.extend(sums[at + 1..at + 1 + n].iter().map(|s| {
+            if count > 0.0 {
+                s / count
+            } else {
+                0.0
+            }
+        }));
+        at += 1 + n;
+    }
+    means
 }
 
 /// What turns a row's kinetic energy and virial into temperature and pressure: Boltzmann's
@@ -470,6 +522,7 @@ pub(crate) fn finish<M: Model>(
     if let Some(colouring) = plan.picture {
         write_picture(plan, &last, colouring, cube.sim.step, cube.sim.time)?;
     }
+    crate::output::pictures::history_pictures(&plan.dir, &plan.title)?;
     if let Some((_, size, secs)) = tally.checkpoints.last() {
         let _ = writeln!(
             timing,
@@ -588,7 +641,8 @@ fn write_picture(
                 ["speed 0".into(), format!("{hi:.3e}")],
             )
         }
-        Colouring::Height => {
+        // `Auto` was resolved when the run was planned.
+        Colouring::Height | Colouring::Auto => {
             let z: Vec<f64> = f.position.iter().map(|x| x[2]).collect();
             let (lo, hi) = range(&z);
             (

@@ -2,7 +2,7 @@
 
 use super::record::{columns, frame_store, Thermo};
 use super::step_loop::{drive, CheckpointPlan, Plan, SolverChoice};
-use crate::input::deck::{Scene, SolverSpec};
+use crate::input::deck::{Colouring, Scene, SolverSpec};
 use crate::input::setup::{self, Setup};
 use crate::model::{Model, ModelVisitor};
 use crate::output::checkpoint::{self, Checkpoint};
@@ -318,7 +318,12 @@ impl<M: Model> Prepared<'_, M> {
                 .pairs
                 .is_some()
                 .then(|| Thermo::of_setup(setup, scene.units.boltzmann())),
-            picture: out.picture,
+            picture: out.picture.map(|c| match c {
+                // Bondless particles (no horizon) have no damage to show.
+                Colouring::Auto if setup.horizon <= 0.0 => Colouring::Speed,
+                Colouring::Auto => Colouring::Damage,
+                c => c,
+            }),
             title: scene.title.clone(),
         }
     }
@@ -505,7 +510,7 @@ fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
     );
     eprint!("{}", summary.timing);
     eprintln!(
-        "results    {}: history.csv, timing.txt{}",
+        "results    {}: history.csv, timing.txt, pictures/ (PNG){}",
         summary.output.display(),
         if frames {
             ", frames.xdmf (open in ParaView; colour by damage)"

@@ -1,7 +1,8 @@
 //! What a run leaves behind: the CSV time history ([`history`]), particle frames for ParaView
 //! ([`frames`]), checkpoints ([`checkpoint`]), files written atomically ([`atomic`]), progress
 //! on the terminal ([`progress`]), the signals that end a run cleanly ([`signals`]), PNG
-//! plots ([`plot`], [`curves`]) and LAMMPS data files ([`lammps_data`]).
+//! plots ([`plot`], [`curves`], the pictures of every run in [`pictures`]) and LAMMPS data
+//! files ([`lammps_data`]).
 
 pub mod atomic;
 pub mod checkpoint;
@@ -9,6 +10,7 @@ pub mod curves;
 pub mod frames;
 pub mod history;
 pub mod lammps_data;
+pub mod pictures;
 pub mod plot;
 pub mod progress;
 pub mod signals;

@@ -37,7 +37,8 @@ impl Converter {
             checkpoint_keep: out.checkpoint_keep.unwrap_or(3),
             restart: out.restart.as_ref().map(PathBuf::from),
             picture: match out.picture.as_deref() {
-                None | Some("none") => None,
+                None => Some(Colouring::Auto),
+                Some("none") => None,
                 Some(name) => Some(Colouring::parse(name).ok_or_else(|| {
                     self.error_at(
                         line,

@@ -215,10 +215,12 @@ pub enum Colouring {
     Speed,
     /// z of the current position, from the lowest to the highest.
     Height,
+    /// Damage where the scene has bonds, else speed (the default).
+    Auto,
 }
 
 impl Colouring {
-    pub const NAMES: [&'static str; 4] = ["damage", "material", "speed", "height"];
+    pub const NAMES: [&'static str; 5] = ["damage", "material", "speed", "height", "auto"];
 
     pub fn parse(name: &str) -> Option<Colouring> {
         Some(match name {
@@ -226,6 +228,7 @@ impl Colouring {
             "material" => Colouring::Material,
             "speed" => Colouring::Speed,
             "height" => Colouring::Height,
+            "auto" => Colouring::Auto,
             _ => return None,
         })
     }
