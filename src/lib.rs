@@ -12,6 +12,7 @@
 //! - [`parallel`] — the wall method: decomposition into procCubes, ghost messages on a
 //!   transport (threads or MPI), team reductions, shuffling, the procCube.
 //! - [`output`] — history, frames, checkpoints, progress, signals, plots.
+//! - [`voids`] — voids on voxels: occupancy from positions, connected empty voxels labelled.
 //! - [`solve`] — quasi-static and static solvers (ADR, the implicit Newton solve, the static
 //!   start).
 //! - [`driver`] — `pdq run` and `pdq check`: the step loop with its outputs.
@@ -29,6 +30,7 @@ pub mod parallel;
 
 pub mod output;
 pub mod solve;
+pub mod voids;
 
 pub mod driver;
 pub mod lab;
