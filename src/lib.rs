@@ -11,8 +11,8 @@
 //!   the built whole scene ([`input::setup`]).
 //! - [`parallel`] — the wall method: decomposition into procCubes, ghost messages on a
 //!   transport (threads or MPI), team reductions, shuffling, the procCube.
-//! - [`output`] — history, frames, checkpoints, progress, signals, plots.
 //! - [`voids`] — voids on voxels: occupancy from positions, connected empty voxels labelled.
+//! - [`output`] — history, frames, checkpoints, progress, signals, plots.
 //! - [`solve`] — quasi-static and static solvers (ADR, the implicit Newton solve, the static
 //!   start).
 //! - [`driver`] — `pdq run` and `pdq check`: the step loop with its outputs.
@@ -27,10 +27,10 @@ pub mod pairs;
 pub mod engine;
 pub mod input;
 pub mod parallel;
+pub mod voids;
 
 pub mod output;
 pub mod solve;
-pub mod voids;
 
 pub mod driver;
 pub mod lab;

@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 
 /// Bottom to top. `models/` (the model files) sits with `model`, the interface it implements.
-const LAYERS: [&str; 8] = [
-    "model", "engine", "input", "parallel", "output", "solve", "driver", "lab",
+const LAYERS: [&str; 9] = [
+    "model", "engine", "input", "parallel", "voids", "output", "solve", "driver", "lab",
 ];
 
 fn rank(layer: &str) -> Option<usize> {
