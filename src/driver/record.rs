@@ -522,7 +522,10 @@ pub(crate) fn finish<M: Model>(
     if let Some(colouring) = plan.picture {
         write_picture(plan, &last, colouring, cube.sim.step, cube.sim.time)?;
     }
-    crate::output::pictures::history_pictures(&plan.dir, &plan.title)?;
+    // The results are written: a picture that cannot be drawn is reported, not fatal.
+    if let Err(e) = crate::output::pictures::history_pictures(&plan.dir, &plan.title) {
+        eprintln!("warning: the history pictures were not drawn: {e}");
+    }
     if let Some((_, size, secs)) = tally.checkpoints.last() {
         let _ = writeln!(
             timing,

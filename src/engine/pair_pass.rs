@@ -125,7 +125,8 @@ impl<L: PairLaw> PairPass<L> {
         broken: &[bool],
     ) -> PairTally {
         let single = self.single;
-        let cut2 = self.law.cutoff() * self.law.cutoff();
+        // The largest cutoff squared, a hair wide: every pair's own cutoff² must lie below it.
+        let cut2 = self.law.cutoff() * self.law.cutoff() * (1.0 + 1e-12);
         let mut t = PairTally::default();
         let near = &mut self.near;
         for i in 0..p.n_owned {

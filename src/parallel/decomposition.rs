@@ -614,6 +614,10 @@ impl CellPlan {
     pub fn owned_index(&self, at: [usize; 3]) -> usize {
         let (lo, hi) = (self.lo, self.hi);
         let [nx, _, nz] = [0, 1, 2].map(|a| (hi[a] - lo[a]) as usize);
+        debug_assert!(
+            (0..3).all(|a| at[a] as i64 >= lo[a] && (at[a] as i64) < hi[a]),
+            "cell {at:?} is not owned ({lo:?}..{hi:?})"
+        );
         let [x, y, z] = [0, 1, 2].map(|a| at[a] - lo[a] as usize);
         // Owned cells are held y slowest, then z, then x (see `cell_plans`).
         (y * nz + z) * nx + x

@@ -55,3 +55,38 @@ fn the_lj_melt_is_the_same_on_1_2_and_4_threads() {
     assert!(final_positions(&again) == reference, "one thread twice");
     std::fs::remove_dir_all(&base).ok();
 }
+
+/// The melt with free faces along z (periodic along x and y only): procCubes cut across a
+/// non-periodic axis, where a procCube has no neighbour on one side, keep every atom once and
+/// follow one thread's trajectory.
+#[test]
+fn the_lj_melt_with_free_faces_is_the_same_cut_across_them() {
+    let text = lj_deck();
+    let periodic = r#"periodic = ["x", "y", "z"]"#;
+    assert!(
+        text.contains(periodic),
+        "inputs/lj_melt.toml lost '{periodic}'"
+    );
+    let text = text.replace(periodic, r#"periodic = ["x", "y"]"#);
+    let base = std::env::temp_dir().join(format!("pdq-md-free-{}", std::process::id()));
+    let one = base.join("one");
+    run_quietly(&text, "lj.toml", &one, layout(1, [1, 1, 1])).unwrap();
+    let reference = final_positions(&one);
+    assert_eq!(reference.len(), 2048);
+    let period = 8.0 * (4.0f64 / 0.8442).cbrt();
+    for (threads, procs) in [(2, [1, 1, 2]), (4, [2, 1, 2])] {
+        let dir = base.join(format!("{procs:?}"));
+        run_quietly(&text, "lj.toml", &dir, layout(threads, procs)).unwrap();
+        let last = final_positions(&dir);
+        assert_eq!(last.len(), 2048, "{procs:?}: atoms lost or doubled");
+        let d = max_distance(&reference, &last, period);
+        eprintln!("{threads} threads {procs:?}, free z faces: positions within {d:.2e}");
+        assert!(d < 1e-9, "{procs:?}: positions differ by {d:e}");
+        let timing = std::fs::read_to_string(dir.join("timing.txt")).unwrap();
+        assert!(
+            timing.contains("by migration") && !timing.contains("(0 by migration"),
+            "{procs:?}: no rebuild by migration:\n{timing}"
+        );
+    }
+    std::fs::remove_dir_all(&base).ok();
+}
