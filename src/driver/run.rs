@@ -1,5 +1,6 @@
 //! `pdq run` and `pdq check`: drive a simulation built from a deck and report on it.
 
+use super::observers::analysis::AnalysisPlan;
 use super::record::{columns, frame_store, Thermo};
 use super::step_loop::{drive, CheckpointPlan, Plan, SolverChoice};
 use crate::input::deck::{Colouring, Scene, SolverSpec};
@@ -12,6 +13,7 @@ use crate::parallel::comm::Transport;
 use crate::parallel::decomposition::{Layout, Procs, Walls};
 use crate::parallel::snapshot::Snapshot;
 use crate::solve::static_start::StaticStart;
+use crate::voids::{Connectivity, Scheme};
 use std::path::PathBuf;
 
 pub use super::check::check;
@@ -325,6 +327,7 @@ impl<M: Model> Prepared<'_, M> {
                 c => c,
             }),
             title: scene.title.clone(),
+            analyses: analysis_plans(setup, scene),
         }
     }
 
@@ -518,4 +521,36 @@ fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
             ""
         }
     );
+}
+
+/// The deck's `[[analysis]]` entries as the step loop runs them.
+fn analysis_plans<M: Model>(setup: &Setup<M>, scene: &Scene) -> Vec<AnalysisPlan> {
+    let p = &setup.sim.particles;
+    // The particle with global id 0 (every worker holds the whole scene at setup).
+    let anchor = p
+        .gid
+        .iter()
+        .position(|&g| g == 0)
+        .map_or([0.0; 3], |i| p.x0[i]);
+    scene
+        .analyses
+        .iter()
+        .map(|a| AnalysisPlan {
+            name: a.name.clone(),
+            kind: a.kind,
+            every: a.every,
+            voxel: a.voxel,
+            connectivity: if a.all_neighbours {
+                Connectivity::All
+            } else {
+                Connectivity::Face
+            },
+            scheme: match a.scheme.as_str() {
+                "min-label" => Scheme::MinLabel,
+                "gather" => Scheme::Gather,
+                _ => Scheme::Boundary,
+            },
+            anchor,
+        })
+        .collect()
 }

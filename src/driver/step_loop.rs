@@ -46,6 +46,8 @@ pub(crate) struct Plan {
     pub picture: Option<crate::input::deck::Colouring>,
     /// The deck's title, for the picture.
     pub title: String,
+    /// `[[analysis]]`: voids and cracks on voxels, in deck order.
+    pub analyses: Vec<super::observers::analysis::AnalysisPlan>,
 }
 
 /// When to write checkpoints, and what identifies them.

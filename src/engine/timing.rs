@@ -18,10 +18,12 @@ pub enum Phase {
     Boundary,
     Integration,
     Output,
+    /// In-situ analyses (`[[analysis]]`: voids and cracks on voxels).
+    Analysis,
 }
 
 impl Phase {
-    pub const ALL: [Phase; 9] = [
+    pub const ALL: [Phase; 10] = [
         Phase::Setup,
         Phase::State,
         Phase::Forces,
@@ -31,6 +33,7 @@ impl Phase {
         Phase::Boundary,
         Phase::Integration,
         Phase::Output,
+        Phase::Analysis,
     ];
 
     pub fn name(self) -> &'static str {
@@ -44,13 +47,14 @@ impl Phase {
             Phase::Boundary => "boundary/loads",
             Phase::Integration => "integration",
             Phase::Output => "output",
+            Phase::Analysis => "analysis",
         }
     }
 }
 
 #[derive(Clone, Debug, Default)]
 pub struct Timing {
-    spent: [Duration; 9],
+    spent: [Duration; 10],
 }
 
 impl Timing {
@@ -92,7 +96,8 @@ impl Timing {
         if particle_steps > 0.0 {
             let stepping = total
                 - self.get(Phase::Setup).as_secs_f64()
-                - self.get(Phase::Output).as_secs_f64();
+                - self.get(Phase::Output).as_secs_f64()
+                - self.get(Phase::Analysis).as_secs_f64();
             let _ = writeln!(
                 s,
                 "step loop: {:.4} us per particle-step",

@@ -1,9 +1,10 @@
 //! What a run leaves behind: the CSV time history ([`history`]), particle frames for ParaView
 //! ([`frames`]), checkpoints ([`checkpoint`]), files written atomically ([`atomic`]), progress
 //! on the terminal ([`progress`]), the signals that end a run cleanly ([`signals`]), PNG
-//! plots ([`plot`], [`curves`], the pictures of every run in [`pictures`]) and LAMMPS data
-//! files ([`lammps_data`]).
+//! plots ([`plot`], [`curves`], the pictures of every run in [`pictures`]), LAMMPS data
+//! files ([`lammps_data`]) and the tables of the voids and cracks analyses ([`analysis`]).
 
+pub mod analysis;
 pub mod atomic;
 pub mod checkpoint;
 pub mod curves;

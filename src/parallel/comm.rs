@@ -281,6 +281,43 @@ impl<T: Transport> Team<T> {
         }
     }
 
+    /// Sends `out[r]` to each worker r; returns what every worker sent here, in rank order
+    /// (this worker's own included). One message to and from every other worker, in rounds
+    /// around the ring, so no two workers wait on each other.
+    pub fn all_to_all(&mut self, mut out: Vec<Vec<u8>>) -> Vec<Vec<u8>> {
+        let (n, me) = (self.size(), self.rank());
+        assert_eq!(out.len(), n, "one message per worker");
+        let tag = self.next_tag();
+        let mut got = vec![Vec::new(); n];
+        got[me] = std::mem::take(&mut out[me]);
+        for k in 1..n {
+            let (to, from) = ((me + k) % n, (me + n - k) % n);
+            self.transport
+                .exchange(tag, Some(to), &out[to], Some(from), &mut got[from]);
+        }
+        got
+    }
+
+    /// The root's `parts[r]` on each worker r (`parts` is read on the root only).
+    pub fn scatter(&mut self, mut parts: Vec<Vec<u8>>) -> Vec<u8> {
+        assert!(
+            !self.is_root() || parts.len() == self.size(),
+            "one part per worker"
+        );
+        let tag = self.next_tag();
+        if self.is_root() {
+            for (r, part) in parts.iter().enumerate().skip(1) {
+                self.transport
+                    .exchange(tag, Some(r), part, None, &mut self.buf);
+            }
+            std::mem::take(&mut parts[0])
+        } else {
+            let mut got = Vec::new();
+            self.transport.exchange(tag, None, &[], Some(0), &mut got);
+            got
+        }
+    }
+
     /// Element-wise reduction of `values` over all workers (in rank order), known everywhere.
     pub fn reduce(&mut self, values: &mut [f64], op: Reduce) {
         let gathered = self.gather(bytemuck::cast_slice(values));

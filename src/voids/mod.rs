@@ -1,55 +1,88 @@
-//! Voids on voxels (Hemani et al. 2014, `shared/seeds/004`): particle positions are put on a
-//! grid of voxels, a voxel holding at least one particle is occupied, and the empty voxels are
-//! joined into connected sets. The set that reaches the grid's border (the grid has one empty
-//! voxel of margin all round) is the outside; every other set is a void inside the body.
+//! Voids and cracks on voxels (Hemani et al. 2014, `shared/seeds/004`): particle positions
+//! are put on a grid of voxels, and connected sets of *marked* voxels are labelled as clusters.
 //!
-//! This is the labelling on one procCube's grid; the merge across procCubes, the tracking
-//! between analyses and the in-situ observer build on it (issue 24).
+//! - **Voids**: a voxel holding at least one particle is occupied; the empty voxels are
+//!   marked. The cluster that reaches the grid's border (the grid has one empty voxel of
+//!   margin on every non-periodic side) is the outside; every other cluster is a void.
+//! - **Cracks**: a voxel holding the midpoint of a broken bond is marked; each cluster is a
+//!   crack, with its broken bonds and their mean opening.
+//!
+//! [`labels`] labels a grid cut into procCubes without gathering it (local union-find, then
+//! the labels merged across procCube faces); [`find_voids`] is the same on one grid.
+//! [`tracking`] follows clusters from one analysis to the next.
 
+pub mod labels;
+pub mod tracking;
 mod union_find;
 
-use union_find::UnionFind;
+pub use labels::{deposit, label, Labelled, Region, Scheme};
 
-/// A grid of cubic voxels.
+/// A grid of voxels, periodic along some axes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VoxelGrid {
     /// The corner of voxel (0, 0, 0).
     pub origin: [f64; 3],
-    /// The side of a voxel.
-    pub size: f64,
+    /// The side of a voxel along each axis: the size asked for, except along a periodic axis,
+    /// where it is stretched a little so that a whole number of voxels spans the period.
+    pub size: [f64; 3],
     pub dims: [usize; 3],
+    /// Along a periodic axis the last voxel touches the first, and there is no margin.
+    pub periodic: [bool; 3],
+    /// Voxel (0, 0, 0)'s coordinates on the fixed voxel lattice of the run: grids of later
+    /// analyses may be larger, and `offset` lets voxels be matched between them.
+    pub offset: [i64; 3],
 }
 
-/// Which empty voxels touch: across a face (6 neighbours, the default) or also across an edge
-/// or a corner (26).
+/// Which marked voxels touch: across a face (6 neighbours) or also across an edge or a
+/// corner (26).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Connectivity {
     Face,
     All,
 }
 
-/// One void: a connected set of empty voxels inside the body.
+impl Connectivity {
+    pub fn name(self) -> &'static str {
+        match self {
+            Connectivity::Face => "face",
+            Connectivity::All => "all",
+        }
+    }
+}
+
+/// One cluster: a void or a crack.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Void {
-    /// 1, 2, … in the order of each void's first voxel (x fastest, then y, then z).
+pub struct Cluster {
+    /// 1, 2, … in the order of each cluster's first voxel (x fastest, then y, then z).
     pub label: u32,
     pub voxels: u64,
     pub volume: f64,
-    /// Area of the voxel faces between the void and occupied voxels. For a smooth surface
+    /// Area of the voxel faces between the cluster and unmarked voxels. For a smooth surface
     /// this counts the staircase: a sphere's comes out about 3/2 of 4πR².
     pub surface: f64,
+    /// Half the length of the vector of those faces' areas by axis: the area of a thin planar
+    /// cluster (a crack) whatever its orientation, as a plane of normal n crosses the faces
+    /// normal to axis a in proportion to |n_a|. For a curved crack it is a lower bound.
+    pub area: f64,
     pub centroid: [f64; 3],
-    /// The radius of a sphere of the void's volume.
+    /// The radius of a sphere of the cluster's volume.
     pub equivalent_radius: f64,
+    /// First and last voxel along each axis.
+    pub first: [usize; 3],
+    pub last: [usize; 3],
+    /// Cracks: the broken bonds whose midpoints lie in the cluster, and their mean opening
+    /// (current length less reference length).
+    pub bonds: u64,
+    pub opening: f64,
 }
 
-/// Every voxel's label and the voids.
+/// Every voxel's label and the voids of one grid.
 #[derive(Clone, Debug)]
 pub struct VoidMap {
     pub grid: VoxelGrid,
     /// Per voxel (x fastest): [`OCCUPIED`], [`OUTSIDE`], or the label of its void.
     pub labels: Vec<u32>,
-    pub voids: Vec<Void>,
+    pub voids: Vec<Cluster>,
 }
 
 /// The label of an occupied voxel.
@@ -57,14 +90,18 @@ pub const OCCUPIED: u32 = u32::MAX;
 /// The label of an empty voxel connected to the outside.
 pub const OUTSIDE: u32 = 0;
 
+/// Along one axis of a grid: periodic with this origin and period, or bounded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Extent {
+    Bounded { lo: f64, hi: f64 },
+    Periodic { origin: f64, period: f64 },
+}
+
 impl VoxelGrid {
     /// The grid of voxels of side `size` around `points`, with one empty voxel of margin on
     /// every side. Voxels are centred on `points[0]`'s lattice: a lattice of spacing `size`
     /// puts one site at the centre of each voxel, so an intact body has no empty voxel.
     pub fn around(points: &[[f64; 3]], size: f64) -> Result<VoxelGrid, String> {
-        if !(size.is_finite() && size > 0.0) {
-            return Err(format!("voxel size must be a positive length, got {size}"));
-        }
         let first = *points
             .first()
             .ok_or("no particles to put on voxels".to_string())?;
@@ -79,20 +116,66 @@ impl VoxelGrid {
                 hi[a] = hi[a].max(p[a]);
             }
         }
-        let mut origin = [0.0; 3];
-        let mut dims = [0usize; 3];
-        for a in 0..3 {
-            // Voxel boundaries half a voxel off the first point's lattice, one voxel of margin.
-            let below = ((first[a] - lo[a]) / size + 0.5).ceil();
-            origin[a] = first[a] - (below + 0.5) * size;
-            let n = ((hi[a] - origin[a]) / size).floor() as usize + 2;
-            dims[a] = n;
+        let extent = [0, 1, 2].map(|a| Extent::Bounded {
+            lo: lo[a],
+            hi: hi[a],
+        });
+        VoxelGrid::spanning(first, extent, size)
+    }
+
+    /// The grid of voxels of side `size` centred on `anchor`'s lattice, spanning each bounded
+    /// axis from `lo` to `hi` with one voxel of margin on each side, and each periodic axis
+    /// exactly (there, voxels are stretched to a whole number per period).
+    pub fn spanning(anchor: [f64; 3], extent: [Extent; 3], size: f64) -> Result<VoxelGrid, String> {
+        if !(size.is_finite() && size > 0.0) {
+            return Err(format!("voxel size must be a positive length, got {size}"));
         }
-        let voxels = dims.iter().try_fold(1usize, |acc, &n| acc.checked_mul(n));
+        let mut grid = VoxelGrid {
+            origin: [0.0; 3],
+            size: [size; 3],
+            dims: [0; 3],
+            periodic: [false; 3],
+            offset: [0; 3],
+        };
+        for a in 0..3 {
+            match extent[a] {
+                Extent::Bounded { lo, hi } => {
+                    if !(lo.is_finite() && hi.is_finite() && anchor[a].is_finite()) {
+                        return Err(format!(
+                            "a particle is at a non-finite position along axis {a}: positions must be finite"
+                        ));
+                    }
+                    // Voxel boundaries half a voxel off the anchor's lattice, one voxel of
+                    // margin below `lo` and above `hi`.
+                    let below = ((anchor[a] - lo) / size + 0.5).ceil();
+                    grid.origin[a] = anchor[a] - (below + 0.5) * size;
+                    grid.offset[a] = -(below as i64);
+                    let n = ((hi - grid.origin[a]) / size).floor() + 2.0;
+                    grid.dims[a] = if n < 1e15 { n as usize } else { usize::MAX };
+                }
+                Extent::Periodic { origin, period } => {
+                    let n = (period / size).round().max(1.0);
+                    let s = period / n;
+                    // The first voxel's centre in [origin, origin + s): centres run through
+                    // the period in order.
+                    let j = ((origin - anchor[a]) / s).ceil();
+                    grid.origin[a] = anchor[a] + (j - 0.5) * s;
+                    grid.offset[a] = j as i64;
+                    grid.size[a] = s;
+                    grid.dims[a] = if n < 1e15 { n as usize } else { usize::MAX };
+                    grid.periodic[a] = true;
+                }
+            }
+        }
+        let voxels = grid
+            .dims
+            .iter()
+            .try_fold(1usize, |acc, &n| acc.checked_mul(n));
         match voxels {
-            Some(v) if v <= 1 << 31 => Ok(VoxelGrid { origin, size, dims }),
+            Some(v) if v <= 1 << 31 => Ok(grid),
             _ => Err(format!(
-                "{dims:?} voxels of {size:e} is more than 2^31: use larger voxels"
+                "{:?} voxels of {size:e} is more than 2^31: use larger voxels",
+                grid.dims
             )),
         }
     }
@@ -105,17 +188,34 @@ impl VoxelGrid {
         self.len() == 0
     }
 
-    /// The voxel holding `p`, if inside the grid.
-    pub fn voxel_of(&self, p: &[f64; 3]) -> Option<usize> {
-        let mut index = 0;
-        for a in (0..3).rev() {
-            let f = ((p[a] - self.origin[a]) / self.size).floor();
-            if !(f >= 0.0 && (f as usize) < self.dims[a]) {
+    /// The coordinates of the voxel holding `p` (wrapped along periodic axes), if inside.
+    pub fn coords_of(&self, p: &[f64; 3]) -> Option<[usize; 3]> {
+        let mut c = [0usize; 3];
+        for a in 0..3 {
+            let f = ((p[a] - self.origin[a]) / self.size[a]).floor();
+            if !f.is_finite() {
                 return None;
             }
-            index = index * self.dims[a] + f as usize;
+            let f = if self.periodic[a] {
+                f.rem_euclid(self.dims[a] as f64)
+            } else {
+                f
+            };
+            if !(f >= 0.0 && f < self.dims[a] as f64) {
+                return None;
+            }
+            c[a] = f as usize;
         }
-        Some(index)
+        Some(c)
+    }
+
+    /// The voxel holding `p`, if inside the grid.
+    pub fn voxel_of(&self, p: &[f64; 3]) -> Option<usize> {
+        self.coords_of(p).map(|c| self.index(c))
+    }
+
+    pub fn index(&self, c: [usize; 3]) -> usize {
+        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
     }
 
     /// Which voxels hold at least one of `points` (points outside the grid are left out).
@@ -129,129 +229,47 @@ impl VoxelGrid {
         occupied
     }
 
-    fn coords(&self, v: usize) -> [usize; 3] {
-        let [nx, ny, _] = self.dims;
-        [v % nx, (v / nx) % ny, v / (nx * ny)]
+    /// The volume of one voxel.
+    pub fn voxel_volume(&self) -> f64 {
+        self.size.iter().product()
     }
 
-    fn centre(&self, v: usize) -> [f64; 3] {
-        let c = self.coords(v);
-        [0, 1, 2].map(|a| self.origin[a] + (c[a] as f64 + 0.5) * self.size)
+    /// The centre of the voxel at (fractional) coordinates `c`.
+    pub fn centre(&self, c: [f64; 3]) -> [f64; 3] {
+        [0, 1, 2].map(|a| self.origin[a] + (c[a] + 0.5) * self.size[a])
+    }
+
+    /// Whether some axis is bounded, so that the grid has a margin and an outside.
+    pub fn has_outside(&self) -> bool {
+        self.periodic.iter().any(|p| !p)
     }
 }
 
-/// Labels the empty voxels of `grid` (`occupied` per voxel) and measures the voids.
+/// Labels the empty voxels of `grid` (`occupied` per voxel) and measures the voids: the
+/// labelling of [`labels`] on one procCube.
 pub fn find_voids(grid: &VoxelGrid, occupied: &[bool], connectivity: Connectivity) -> VoidMap {
     assert_eq!(occupied.len(), grid.len(), "one occupancy flag per voxel");
-    let [nx, ny, nz] = grid.dims;
-    let index = |x: usize, y: usize, z: usize| (z * ny + y) * nx + x;
-    // Neighbours reached from a voxel towards smaller indices: every touching pair once.
-    let back: Vec<[i64; 3]> = match connectivity {
-        Connectivity::Face => vec![[-1, 0, 0], [0, -1, 0], [0, 0, -1]],
-        Connectivity::All => {
-            let mut v = Vec::new();
-            for dz in -1..=1 {
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        if (dz, dy, dx) < (0, 0, 0) {
-                            v.push([dx, dy, dz]);
-                        }
-                    }
-                }
-            }
-            v
-        }
-    };
-    let mut sets = UnionFind::new(grid.len());
-    for z in 0..nz {
-        for y in 0..ny {
-            for x in 0..nx {
-                let v = index(x, y, z);
-                if occupied[v] {
-                    continue;
-                }
-                for d in &back {
-                    let (a, b, c) = (x as i64 + d[0], y as i64 + d[1], z as i64 + d[2]);
-                    if a < 0 || b < 0 || c < 0 || a >= nx as i64 || b >= ny as i64 {
-                        continue;
-                    }
-                    let u = index(a as usize, b as usize, c as usize);
-                    if !occupied[u] {
-                        sets.join(u, v);
-                    }
-                }
-            }
-        }
-    }
-    label_and_measure(grid, occupied, &mut sets)
-}
-
-/// Labels from the sets: the one holding voxel 0 (a margin voxel, always empty) is the
-/// outside; the others are numbered in order of their first voxel.
-fn label_and_measure(grid: &VoxelGrid, occupied: &[bool], sets: &mut UnionFind) -> VoidMap {
-    let outside = sets.root(0);
-    let mut label_of_root: Vec<u32> = vec![OCCUPIED; grid.len()];
-    let mut labels = vec![OCCUPIED; grid.len()];
-    let mut voids: Vec<Void> = Vec::new();
-    let mut sums: Vec<[f64; 3]> = Vec::new();
-    let cell = grid.size.powi(3);
-    for v in 0..grid.len() {
-        if occupied[v] {
-            continue;
-        }
-        let r = sets.root(v);
-        if r == outside {
-            labels[v] = OUTSIDE;
-            continue;
-        }
-        if label_of_root[r] == OCCUPIED {
-            label_of_root[r] = voids.len() as u32 + 1;
-            voids.push(Void {
-                label: voids.len() as u32 + 1,
-                voxels: 0,
-                volume: 0.0,
-                surface: 0.0,
-                centroid: [0.0; 3],
-                equivalent_radius: 0.0,
-            });
-            sums.push([0.0; 3]);
-        }
-        let l = label_of_root[r];
-        labels[v] = l;
-        let k = l as usize - 1;
-        voids[k].voxels += 1;
-        let c = grid.centre(v);
-        for a in 0..3 {
-            sums[k][a] += c[a];
-        }
-        voids[k].surface += occupied_faces(grid, occupied, v) as f64 * grid.size * grid.size;
-    }
-    for (w, s) in voids.iter_mut().zip(&sums) {
-        w.volume = w.voxels as f64 * cell;
-        w.centroid = s.map(|x| x / w.voxels as f64);
-        w.equivalent_radius = (3.0 * w.volume / (4.0 * std::f64::consts::PI)).cbrt();
-    }
+    let region = Region::whole(grid.clone());
+    let empty: Vec<bool> = occupied.iter().map(|o| !o).collect();
+    let mut team = crate::parallel::comm::Team::new(crate::parallel::comm::Solo::new());
+    let found = label(
+        &mut team,
+        &region,
+        &empty,
+        &[],
+        connectivity,
+        Scheme::Boundary,
+    );
+    let labels = occupied
+        .iter()
+        .zip(&found.labels)
+        .map(|(&o, &l)| if o { OCCUPIED } else { l })
+        .collect();
     VoidMap {
         grid: grid.clone(),
         labels,
-        voids,
+        voids: found.clusters,
     }
-}
-
-/// How many of voxel `v`'s six faces it shares with an occupied voxel.
-fn occupied_faces(grid: &VoxelGrid, occupied: &[bool], v: usize) -> u32 {
-    let c = grid.coords(v);
-    let stride = [1, grid.dims[0], grid.dims[0] * grid.dims[1]];
-    let mut n = 0;
-    for a in 0..3 {
-        if c[a] > 0 && occupied[v - stride[a]] {
-            n += 1;
-        }
-        if c[a] + 1 < grid.dims[a] && occupied[v + stride[a]] {
-            n += 1;
-        }
-    }
-    n
 }
 
 impl VoidMap {

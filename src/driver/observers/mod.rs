@@ -1,8 +1,10 @@
 //! What watches a run: the history rows (with the probes' stops), the frames, the checkpoints
-//! (with the signals), the progress line and the stop criteria are [`Observer`]s of the step
-//! loop (`step_loop::drive`), called in the order of [`observers`] after every step. In-situ
-//! analysis plugs in here: an observer of its own (copy `history.rs`), added to that list.
+//! (with the signals), the progress line, the stop criteria and the in-situ analyses
+//! (`[[analysis]]`: voids and cracks) are [`Observer`]s of the step loop (`step_loop::drive`),
+//! called in the order of [`observers`] after every step. Another watcher plugs in the same
+//! way: an observer of its own (copy `history.rs`), added to that list.
 
+pub(crate) mod analysis;
 mod checkpoints;
 mod frames;
 mod history;
@@ -122,9 +124,9 @@ fn frame_due(plan: &Plan, step: u64, last: bool) -> bool {
 }
 
 /// One worker's observers, in the order they run, and what they share. The order matters: a
-/// stop criterion before the outputs makes its step the last, so its row, frame and checkpoint
-/// are written; the blow-up check comes before anything records the state; the frame after
-/// the row, whose broken-bond count it carries.
+/// stop criterion before the outputs makes its step the last, so its row, frame, analyses and
+/// checkpoint are written; the blow-up check comes before anything records the state; the
+/// frame after the row, whose broken-bond count it carries.
 pub(crate) fn observers<'a, M: Model>(
     plan: &'a Plan,
     cube: &mut Cube<M>,
@@ -151,14 +153,22 @@ pub(crate) fn observers<'a, M: Model>(
         }
     }
     let progress = Progress::new(plan.steps, root && plan.progress && !plan.quiet);
-    let list: Vec<Box<dyn Observer<M> + 'a>> = vec![
+    let mut list: Vec<Box<dyn Observer<M> + 'a>> = vec![
         Box::new(stops::BrokenBonds::new(plan)),
         Box::new(stops::BlowUp::new(plan)),
         Box::new(history),
         Box::new(frames::FrameSeries::new(plan)),
-        Box::new(ProgressLine(progress)),
-        Box::new(checkpoints::Checkpoints::new(plan, workers)),
     ];
+    for a in &plan.analyses {
+        list.push(Box::new(analysis::Analysis::open(
+            plan,
+            a,
+            root,
+            &mut watch.error,
+        )));
+    }
+    list.push(Box::new(ProgressLine(progress)));
+    list.push(Box::new(checkpoints::Checkpoints::new(plan, workers)));
     (watch, list)
 }
 

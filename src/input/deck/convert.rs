@@ -99,6 +99,9 @@ impl Converter {
         // always have been, so that a deck with several mistakes still reports the same first.
         let periodic = self.periodic(&deck.lattice)?;
         let probes = self.probes(&deck.probe)?;
+        let bonded = bondless.is_none();
+        let bond_drops = (pair.is_some() && bonded) || parallel.shuffle_every > 0;
+        let analyses = self.analyses(&deck.analysis, lattice.spacing, !bonded, bond_drops)?;
         Ok(Scene {
             file: self.file.clone(),
             periodic,
@@ -126,6 +129,7 @@ impl Converter {
             velocity,
             output,
             probes,
+            analyses,
             solver,
             pair,
             thermostat,

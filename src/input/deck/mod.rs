@@ -10,8 +10,8 @@
 //! it into its part of the [`Scene`] (the types of `spec.rs`), one method per section:
 //! `[model]` and `[materials]` in `model.rs`, `[lattice]` in `lattice.rs`, `[[geometry]]` and
 //! the shapes of regions in `shape.rs`, `[[bar]]` in `bar.rs`, `[[boundary]]`, `[[load]]` and
-//! `[[initial]]` in `boundary.rs`, `[time]` and `[solver]` in `time.rs`, `[output]` and
-//! `[[probe]]` in `output.rs`, `[parallel]` in `parallel.rs`, `[thermostat]` in
+//! `[[initial]]` in `boundary.rs`, `[time]` and `[solver]` in `time.rs`, `[output]`,
+//! `[[probe]]` and `[[analysis]]` in `output.rs`, `[parallel]` in `parallel.rs`, `[thermostat]` in
 //! `thermostat.rs`. A deck in `units = "lj"` is first searched for values written with
 //! units, which it cannot take (`plain.rs`).
 
@@ -32,9 +32,9 @@ mod time;
 
 pub use super::materials::MaterialLines;
 pub use spec::{
-    BarSpec, BoundarySpec, Colouring, CriticalStep, InitialSpec, LoadKind, LoadSpec, Located,
-    ModelLines, OutputSpec, ParallelSpec, ProbeSpec, Region, RunLength, Scene, SolverSpec,
-    ThermostatKind, ThermostatSpec, TimeSpec, VelocitySpec,
+    AnalysisKind, AnalysisSpec, BarSpec, BoundarySpec, Colouring, CriticalStep, InitialSpec,
+    LoadKind, LoadSpec, Located, ModelLines, OutputSpec, ParallelSpec, ProbeSpec, Region,
+    RunLength, Scene, SolverSpec, ThermostatKind, ThermostatSpec, TimeSpec, VelocitySpec,
 };
 
 use convert::{Converter, LineIndex};

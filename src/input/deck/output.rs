@@ -1,9 +1,10 @@
-//! `[output]` and `[[probe]]`: where the run writes, how often, its checkpoints, and the
-//! points whose displacement is recorded (and may end the run).
+//! `[output]`, `[[probe]]` and `[[analysis]]`: where the run writes, how often, its
+//! checkpoints, the points whose displacement is recorded (and may end the run), and the
+//! voids and cracks analysed on the way.
 
 use super::convert::{valid_name, Converter, R};
-use super::sections::{OutputSection, ProbeSection};
-use super::spec::{Colouring, OutputSpec, ProbeSpec};
+use super::sections::{AnalysisSection, OutputSection, ProbeSection};
+use super::spec::{AnalysisKind, AnalysisSpec, Colouring, OutputSpec, ProbeSpec};
 use std::path::PathBuf;
 use toml::Spanned;
 
@@ -95,5 +96,101 @@ impl Converter {
             });
         }
         Ok(probes)
+    }
+
+    /// The analyses in deck order. `spacing` is the default voxel; `bondless`: the model has
+    /// no bonds to crack; `bond_drops`: shuffles drop broken bonds from the bond list, out of a
+    /// crack analysis's sight.
+    pub(super) fn analyses(
+        &self,
+        entries: &[Spanned<AnalysisSection>],
+        spacing: f64,
+        bondless: bool,
+        bond_drops: bool,
+    ) -> R<Vec<AnalysisSpec>> {
+        let mut analyses: Vec<AnalysisSpec> = Vec::new();
+        for e in entries {
+            let (a, line) = (e.get_ref(), self.line_of(e));
+            let kind =
+                match a.kind.as_str() {
+                    "voids" => AnalysisKind::Voids,
+                    "cracks" => AnalysisKind::Cracks,
+                    k => return self.err(
+                        line,
+                        format!(
+                            "[[analysis]] kind '{k}' is not known (use \"voids\" or \"cracks\")"
+                        ),
+                    ),
+                };
+            let name = a.name.clone().unwrap_or_else(|| kind.name().to_string());
+            if !valid_name(&name) {
+                return self.err(
+                    line,
+                    format!("analysis name '{name}' must be letters, digits, '_' or '-'"),
+                );
+            }
+            if analyses.iter().any(|x| x.name == name) {
+                return self.err(
+                    line,
+                    format!("analysis name '{name}' is used twice (it names the analysis's files): give each [[analysis]] its own `name`"),
+                );
+            }
+            if a.every < 1 {
+                return self.err(
+                    line,
+                    format!(
+                        "[[analysis]] every = {}: give a number of steps ≥ 1",
+                        a.every
+                    ),
+                );
+            }
+            let voxel = a.voxel.as_ref().map_or(spacing, |v| v.value(self.sys));
+            if !(voxel.is_finite() && voxel > 0.0) {
+                return self.err(
+                    line,
+                    format!("[[analysis]] voxel must be a length > 0 (got {voxel})"),
+                );
+            }
+            let all_neighbours = match a.connectivity.as_deref() {
+                None => kind == AnalysisKind::Cracks,
+                Some("face") => false,
+                Some("all") => true,
+                Some(c) => {
+                    return self.err(
+                        line,
+                        format!("[[analysis]] connectivity '{c}' is not known (use \"face\": 6 neighbours, or \"all\": 26)"),
+                    )
+                }
+            };
+            let scheme = a.scheme.clone().unwrap_or_else(|| "boundary".into());
+            if !["boundary", "min-label", "gather"].contains(&scheme.as_str()) {
+                return self.err(
+                    line,
+                    format!("[[analysis]] scheme '{scheme}' is not known (use \"boundary\", \"min-label\" or \"gather\")"),
+                );
+            }
+            if kind == AnalysisKind::Cracks && bondless {
+                return self.err(
+                    line,
+                    "[[analysis]] kind = \"cracks\" looks for broken bonds, and this model has none (no horizon): use kind = \"voids\"",
+                );
+            }
+            if kind == AnalysisKind::Cracks && bond_drops {
+                return self.err(
+                    line,
+                    "[[analysis]] kind = \"cracks\" cannot run beside shuffles of a bonded scene ([parallel] shuffle_every, or a [pair] law with bonds): a shuffle drops broken bonds from the bond list, where the analysis would not see them",
+                );
+            }
+            analyses.push(AnalysisSpec {
+                name,
+                line,
+                kind,
+                every: a.every as u64,
+                voxel,
+                all_neighbours,
+                scheme,
+            });
+        }
+        Ok(analyses)
     }
 }

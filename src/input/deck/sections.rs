@@ -38,6 +38,8 @@ pub(super) struct DeckFile {
     #[serde(default)]
     pub(super) probe: Vec<Spanned<ProbeSection>>,
     #[serde(default)]
+    pub(super) analysis: Vec<Spanned<AnalysisSection>>,
+    #[serde(default)]
     pub(super) parallel: Option<Spanned<ParallelSection>>,
     #[serde(default)]
     pub(super) solver: Option<Spanned<SolverSection>>,
@@ -281,6 +283,18 @@ pub(super) struct ProbeSection {
     pub(super) name: String,
     pub(super) at: Position,
     pub(super) stop_beyond: Option<Length>,
+}
+
+/// `[[analysis]]`: voids or cracks on voxels, in the step loop every `every` steps.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct AnalysisSection {
+    pub(super) kind: String,
+    pub(super) name: Option<String>,
+    pub(super) every: i64,
+    pub(super) voxel: Option<Length>,
+    pub(super) connectivity: Option<String>,
+    pub(super) scheme: Option<String>,
 }
 
 /// `[pair]`: a non-bonded pair law beside the bonded model (`pairs/`), its per-material

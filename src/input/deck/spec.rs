@@ -248,6 +248,40 @@ pub struct ProbeSpec {
     pub stop_beyond: f64,
 }
 
+/// What an `[[analysis]]` looks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AnalysisKind {
+    /// Connected empty voxels inside the body.
+    Voids,
+    /// Connected voxels holding the midpoints of broken bonds.
+    Cracks,
+}
+
+impl AnalysisKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            AnalysisKind::Voids => "voids",
+            AnalysisKind::Cracks => "cracks",
+        }
+    }
+}
+
+/// An `[[analysis]]` entry, its defaults filled in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnalysisSpec {
+    /// Names its files: `NAME.csv`, `NAME_clusters.csv`, `NAME_events.csv`.
+    pub name: String,
+    pub line: usize,
+    pub kind: AnalysisKind,
+    pub every: u64,
+    /// The voxel side (default: the lattice spacing, for fcc and bcc the cubic cell).
+    pub voxel: f64,
+    /// Voxels touching across edges and corners join too (default: only for cracks).
+    pub all_neighbours: bool,
+    /// `"boundary"`, `"min-label"` or `"gather"`.
+    pub scheme: String,
+}
+
 /// A `[[bar]]` entry: the bar, the initial strain of its own bonds and its line.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BarSpec {
@@ -345,6 +379,8 @@ pub struct Scene {
     pub velocity: Option<VelocitySpec>,
     pub output: OutputSpec,
     pub probes: Vec<ProbeSpec>,
+    /// The `[[analysis]]` entries in deck order.
+    pub analyses: Vec<AnalysisSpec>,
     /// `[solver]`, at line 0 if the deck leaves it out.
     pub solver: Located<SolverSpec>,
     /// The non-bonded pair law, if the deck has a `[pair]` section.

@@ -1,0 +1,370 @@
+//! Voids and cracks on voxels over procCubes (issue 24): the same labels and clusters on 1, 2,
+//! 4 and 8 procCubes and with each merge scheme as on one grid, periodic grids, and the
+//! tracking events. The runs through decks (threads and MPI) are in `tests/inputs.rs` and
+//! `tests/mpi_runs.rs`.
+
+use pdq::parallel::comm::{Team, Threads};
+use pdq::voids::tracking::{EventKind, Tracker};
+use pdq::voids::{
+    deposit, find_voids, label, Cluster, Connectivity, Extent, Labelled, Region, Scheme, VoxelGrid,
+};
+
+/// Sites of a cubic lattice of spacing 1 filling [0, n) along each axis, less those `removed`.
+fn block(n: [usize; 3], removed: impl Fn([f64; 3]) -> bool) -> Vec<[f64; 3]> {
+    let mut p = Vec::new();
+    for z in 0..n[2] {
+        for y in 0..n[1] {
+            for x in 0..n[0] {
+                let s = [x as f64, y as f64, z as f64];
+                if !removed(s) {
+                    p.push(s);
+                }
+            }
+        }
+    }
+    p
+}
+
+fn ball(c: [f64; 3], r: f64) -> impl Fn([f64; 3]) -> bool {
+    move |s| (0..3).map(|a| (s[a] - c[a]).powi(2)).sum::<f64>() < r * r
+}
+
+/// Labels `points` on procCubes cut at `walls` (on threads), the points dealt out to the
+/// workers in turn, so that most are deposited on another procCube's voxels. Returns each
+/// voxel's label over the whole grid and the root's clusters and rounds.
+fn labelled_on(
+    grid: &VoxelGrid,
+    walls: &[Vec<f64>; 3],
+    points: &[[f64; 3]],
+    connectivity: Connectivity,
+    scheme: Scheme,
+) -> (Vec<u32>, Vec<Cluster>, u32) {
+    let n: usize = walls.iter().map(|w| w.len() + 1).product();
+    let results: Vec<(Region, Labelled)> = std::thread::scope(|s| {
+        let handles: Vec<_> = Threads::team(n)
+            .into_iter()
+            .map(|t| {
+                s.spawn(move || {
+                    let mut team = Team::new(t);
+                    let rank = team.rank();
+                    let region = Region::new(grid.clone(), walls.clone(), rank).unwrap();
+                    let mine: Vec<[f64; 3]> =
+                        points.iter().skip(rank).step_by(n).copied().collect();
+                    let (occupied, _) = deposit(&mut team, &region, &mine, &[]);
+                    let empty: Vec<bool> = occupied.iter().map(|o| !o).collect();
+                    let found = label(&mut team, &region, &empty, &[], connectivity, scheme);
+                    (region, found)
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    let mut labels = vec![u32::MAX; grid.len()];
+    for (region, found) in &results {
+        for (v, &l) in found.labels.iter().enumerate() {
+            let g = grid.index(region.coords(v));
+            assert_eq!(labels[g], u32::MAX, "voxel {g} held twice");
+            labels[g] = l;
+        }
+    }
+    assert!(
+        labels.iter().all(|&l| l != u32::MAX),
+        "a voxel nobody holds"
+    );
+    let root = &results[0].1;
+    (labels, root.clusters.clone(), root.rounds)
+}
+
+const LAYOUTS: [[&[f64]; 3]; 6] = [
+    [&[], &[], &[]],
+    [&[19.7], &[], &[]],
+    [&[19.7], &[9.2], &[]],
+    [&[12.0, 27.5], &[], &[]],
+    [&[10.3], &[6.0], &[11.1]],
+    [&[7.6, 16.2, 31.0], &[], &[]],
+];
+
+fn walls(w: [&[f64]; 3]) -> [Vec<f64>; 3] {
+    w.map(|x| x.to_vec())
+}
+
+#[test]
+fn holes_give_the_same_voids_on_every_layout_and_scheme() {
+    let holes = [
+        ([8.0, 9.5, 9.5], 4.0),
+        ([20.0, 9.0, 10.0], 3.0),
+        ([30.5, 10.0, 9.0], 2.5),
+    ];
+    // A slot joins a fourth and fifth hole across the wall at x = 19.7.
+    let joined = |s: [f64; 3]| {
+        ball([16.0, 4.0, 14.0], 1.6)(s)
+            || ball([24.0, 4.0, 14.0], 1.6)(s)
+            || (s[0] > 16.0 && s[0] < 24.0 && s[1] == 4.0 && s[2] == 14.0)
+    };
+    let points = block([40, 20, 20], |s| {
+        holes.iter().any(|&(c, r)| ball(c, r)(s)) || joined(s)
+    });
+    let grid = VoxelGrid::around(&points, 1.0).unwrap();
+    for connectivity in [Connectivity::Face, Connectivity::All] {
+        let one = find_voids(&grid, &grid.occupancy(&points), connectivity);
+        assert_eq!(one.voids.len(), 4, "{:?}", one.voids);
+        let expected: Vec<u32> = one
+            .labels
+            .iter()
+            .map(|&l| if l == u32::MAX { 0 } else { l })
+            .collect();
+        for layout in LAYOUTS {
+            for scheme in [Scheme::Boundary, Scheme::MinLabel, Scheme::Gather] {
+                let (labels, clusters, _) =
+                    labelled_on(&grid, &walls(layout), &points, connectivity, scheme);
+                let what = format!("{layout:?}, {scheme:?}, {connectivity:?}");
+                assert!(labels == expected, "labels differ on {what}");
+                assert_eq!(clusters, one.voids, "clusters differ on {what}");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_min_label_scheme_takes_more_rounds_for_a_void_across_more_procubes() {
+    // A tube along x through the whole block, closed at both ends.
+    let tube = |s: [f64; 3]| s[0] >= 2.0 && s[0] <= 37.0 && s[1] == 10.0 && s[2] == 10.0;
+    let points = block([40, 20, 20], tube);
+    let grid = VoxelGrid::around(&points, 1.0).unwrap();
+    let rounds = |w: [&[f64]; 3]| {
+        let (_, clusters, rounds) = labelled_on(
+            &grid,
+            &walls(w),
+            &points,
+            Connectivity::Face,
+            Scheme::MinLabel,
+        );
+        assert_eq!(clusters.len(), 1);
+        assert_eq!(clusters[0].voxels, 36);
+        rounds
+    };
+    let (one, two, four) = (rounds(LAYOUTS[0]), rounds(LAYOUTS[1]), rounds(LAYOUTS[5]));
+    assert_eq!(one, 1);
+    assert!(two > one && four > two, "rounds {one}, {two}, {four}");
+}
+
+#[test]
+fn a_void_across_a_periodic_boundary_is_one_void() {
+    // Periodic along x with period 30: a hole centred on the boundary wraps around.
+    let points = block([30, 12, 12], |s| {
+        ball([0.0, 6.0, 6.0], 3.0)(s) || ball([30.0, 6.0, 6.0], 3.0)(s)
+    });
+    let extent = [
+        Extent::Periodic {
+            origin: -0.5,
+            period: 30.0,
+        },
+        Extent::Bounded { lo: 0.0, hi: 11.0 },
+        Extent::Bounded { lo: 0.0, hi: 11.0 },
+    ];
+    let grid = VoxelGrid::spanning([0.0; 3], extent, 1.0).unwrap();
+    assert_eq!(grid.dims, [30, 14, 14]);
+    let removed = 30 * 12 * 12 - points.len();
+    for w in [
+        [&[][..], &[], &[]],
+        [&[14.6][..], &[], &[]],
+        [&[9.5, 19.5][..], &[], &[]],
+    ] {
+        let (_, clusters, _) = labelled_on(
+            &grid,
+            &walls(w),
+            &points,
+            Connectivity::Face,
+            Scheme::Boundary,
+        );
+        assert_eq!(clusters.len(), 1, "{w:?}: {clusters:?}");
+        assert_eq!(clusters[0].voxels as usize, removed);
+    }
+}
+
+#[test]
+fn a_fully_periodic_grid_has_no_outside() {
+    let points = block([16, 16, 16], ball([8.0, 8.0, 8.0], 3.0));
+    let extent = [Extent::Periodic {
+        origin: -0.5,
+        period: 16.0,
+    }; 3];
+    let grid = VoxelGrid::spanning([0.0; 3], extent, 1.0).unwrap();
+    assert!(!grid.has_outside());
+    let (_, clusters, _) = labelled_on(
+        &grid,
+        &walls([&[7.9], &[8.1], &[]]),
+        &points,
+        Connectivity::Face,
+        Scheme::Boundary,
+    );
+    assert_eq!(clusters.len(), 1);
+    assert_eq!(clusters[0].voxels as usize, 16 * 16 * 16 - points.len());
+}
+
+#[test]
+fn values_are_summed_per_cluster_on_any_layout() {
+    // Two sheets of "bond midpoints" with openings: each sheet is one cluster.
+    let sheet = |x: f64| -> Vec<[f64; 3]> {
+        let mut p = Vec::new();
+        for z in 2..18 {
+            for y in 2..10 {
+                p.push([x, y as f64, z as f64]);
+            }
+        }
+        p
+    };
+    let mut mids = sheet(8.0);
+    mids.extend(sheet(25.0));
+    let values: Vec<[f64; 2]> = mids.iter().map(|p| [0.01 * (p[1] + p[2]), 1.0]).collect();
+    let body = block([40, 12, 20], |_| false);
+    let grid = VoxelGrid::around(&body, 1.0).unwrap();
+    for layout in LAYOUTS {
+        let w = walls(layout);
+        let n: usize = w.iter().map(|x| x.len() + 1).product();
+        let roots: Vec<Labelled> = std::thread::scope(|s| {
+            let handles: Vec<_> = Threads::team(n)
+                .into_iter()
+                .map(|t| {
+                    let (w, mids, values, grid) = (&w, &mids, &values, &grid);
+                    s.spawn(move || {
+                        let mut team = Team::new(t);
+                        let rank = team.rank();
+                        let region = Region::new(grid.clone(), w.clone(), rank).unwrap();
+                        let mine: Vec<usize> = (rank..mids.len()).step_by(n).collect();
+                        let pts: Vec<[f64; 3]> = mine.iter().map(|&k| mids[k]).collect();
+                        let val: Vec<[f64; 2]> = mine.iter().map(|&k| values[k]).collect();
+                        let (marked, sums) = deposit(&mut team, &region, &pts, &val);
+                        label(
+                            &mut team,
+                            &region,
+                            &marked,
+                            &sums,
+                            Connectivity::All,
+                            Scheme::Boundary,
+                        )
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap()).collect()
+        });
+        let c = &roots[0].clusters;
+        assert_eq!(c.len(), 2, "{layout:?}");
+        for k in 0..2 {
+            assert_eq!(c[k].bonds, 8 * 16);
+            assert_eq!(c[k].voxels, 8 * 16);
+            // Mean of 0.01 (y + z) over y in 2..10, z in 2..18: 0.01 (5.5 + 9.5).
+            assert!((c[k].opening - 0.15).abs() < 1e-12, "{}", c[k].opening);
+            // A one-voxel sheet of 8 × 16: its area, and its edges' faces (2 %).
+            assert!((c[k].area - 128.0).abs() < 0.02 * 128.0, "{}", c[k].area);
+            assert_eq!(c[k].first, [[9, 3, 3], [26, 3, 3]][k]);
+            assert_eq!(c[k].last, [[9, 10, 18], [26, 10, 18]][k]);
+        }
+    }
+}
+
+#[test]
+fn an_oblique_sheet_has_its_area() {
+    // A staircase sheet x + y = 20 (normal (1, 1, 0)/√2), 2 voxels thick along x.
+    let mut mids = Vec::new();
+    for z in 0..10 {
+        for y in 0..16 {
+            for t in 0..2 {
+                mids.push([(20 - y + t) as f64, y as f64, z as f64]);
+            }
+        }
+    }
+    let body = block([30, 20, 12], |_| false);
+    let grid = VoxelGrid::around(&body, 1.0).unwrap();
+    let marked = grid.occupancy(&mids);
+    let region = Region::whole(grid.clone());
+    let mut team = Team::new(pdq::parallel::comm::Solo::new());
+    let found = label(
+        &mut team,
+        &region,
+        &marked,
+        &[],
+        Connectivity::All,
+        Scheme::Boundary,
+    );
+    assert_eq!(found.clusters.len(), 1);
+    // 16 steps of √2 by 10: 226.3; the edges of the sheet add to the face counts.
+    let area = 16.0 * 2f64.sqrt() * 10.0;
+    let a = found.clusters[0].area;
+    assert!((a - area).abs() / area < 0.12, "{a} vs {area}");
+}
+
+/// Voids of `points` on one grid of the run's voxel lattice (anchored at the origin).
+fn analyse(
+    points: &[[f64; 3]],
+    tracker: &mut Tracker,
+) -> (Labelled, Vec<pdq::voids::tracking::Event>) {
+    let extent = [Extent::Bounded { lo: 0.0, hi: 39.0 }; 3];
+    let grid = VoxelGrid::spanning([0.0; 3], extent, 1.0).unwrap();
+    let region = Region::whole(grid.clone());
+    let mut team = Team::new(pdq::parallel::comm::Solo::new());
+    let (occupied, _) = deposit(&mut team, &region, points, &[]);
+    let empty: Vec<bool> = occupied.iter().map(|o| !o).collect();
+    let found = label(
+        &mut team,
+        &region,
+        &empty,
+        &[],
+        Connectivity::Face,
+        Scheme::Boundary,
+    );
+    let (events, _) = tracker.follow(&mut team, &region, &found);
+    (found, events)
+}
+
+#[test]
+fn two_voids_growing_into_one_are_one_coalescence_with_both_parents() {
+    let mut tracker = Tracker::new(1, false);
+    let at = |r: f64, third: bool| {
+        block([40, 40, 40], |s| {
+            ball([13.0, 20.0, 20.0], r)(s)
+                || ball([27.0, 20.0, 20.0], r)(s)
+                || (third && ball([20.0, 8.0, 30.0], 2.0)(s))
+        })
+    };
+    let (first, events) = analyse(&at(3.0, false), &mut tracker);
+    assert_eq!(first.clusters.len(), 2);
+    let kinds: Vec<_> = events.iter().map(|e| (e.kind, e.id)).collect();
+    assert_eq!(
+        kinds,
+        [(EventKind::Nucleated, 1), (EventKind::Nucleated, 2)]
+    );
+    // Both grow; a third nucleates.
+    let (_, events) = analyse(&at(5.0, true), &mut tracker);
+    let kinds: Vec<_> = events.iter().map(|e| (e.kind, e.id)).collect();
+    assert_eq!(
+        kinds,
+        [
+            (EventKind::Grew, 1),
+            (EventKind::Grew, 2),
+            (EventKind::Nucleated, 3)
+        ]
+    );
+    // They touch: one void, one coalescence with parents 1 and 2; the third closes.
+    let (merged, events) = analyse(&at(7.5, false), &mut tracker);
+    assert_eq!(merged.clusters.len(), 1);
+    assert_eq!(events.len(), 2, "{events:?}");
+    assert_eq!(events[0].kind, EventKind::Coalesced);
+    assert_eq!(events[0].parents, [1, 2]);
+    assert_eq!(events[0].id, 4);
+    assert_eq!(events[0].volume, merged.clusters[0].volume);
+    assert_eq!((events[1].kind, events[1].id), (EventKind::Closed, 3));
+    // And split again.
+    let (_, events) = analyse(&at(5.0, false), &mut tracker);
+    let kinds: Vec<_> = events
+        .iter()
+        .map(|e| (e.kind, e.id, e.parents.clone()))
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            (EventKind::Split, 5, vec![4]),
+            (EventKind::Split, 6, vec![4])
+        ]
+    );
+}
