@@ -265,3 +265,37 @@ fn restarts_under_mpi() {
     assert!(d <= 1e-12, "positions differ by {d:e}");
     let _ = std::fs::remove_dir_all(work);
 }
+
+/// Voids under MPI (issue 24): the holes deck's voids table on 2 and 4 ranks is the one
+/// thread's, byte for byte, with the default merge and with the min-label one.
+#[test]
+fn voids_on_ranks_are_the_threads_voids() {
+    let deck = Path::new("tests/decks/holes.toml");
+    let reference = out_dir("voids-threads");
+    threads_reference(deck, &reference);
+    let table = std::fs::read_to_string(reference.join("voids_clusters.csv")).unwrap();
+    assert_eq!(table.lines().filter(|l| l.starts_with("0,")).count(), 3);
+    let text = std::fs::read_to_string(deck).unwrap();
+    let min_label = out_dir("voids-min-label.toml");
+    std::fs::write(
+        &min_label,
+        text.replace(
+            "kind = \"voids\"",
+            "kind = \"voids\"\nscheme = \"min-label\"",
+        ),
+    )
+    .unwrap();
+    for (np, d) in [(2, deck), (4, deck), (4, min_label.as_path())] {
+        let dir = out_dir(&format!("voids-{np}"));
+        mpirun_deck(np, d, &[], &dir);
+        let got = std::fs::read_to_string(dir.join("voids_clusters.csv")).unwrap();
+        assert!(
+            got == table,
+            "{np} ranks ({}):\n{got}\nthreads:\n{table}",
+            d.display()
+        );
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+    let _ = std::fs::remove_file(min_label);
+    std::fs::remove_dir_all(reference).unwrap();
+}

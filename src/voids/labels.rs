@@ -176,15 +176,20 @@ impl Region {
 }
 
 /// Marks on each procCube's region: the voxels holding at least one of `points` (owned by any
-/// procCube), and per voxel the sums of `values` (one pair per point, or none at all) of the
-/// points in it. A point's voxel may belong to another procCube; it is sent there.
+/// procCube), and with `values` (one pair per point) their sums per voxel. A point's voxel may
+/// belong to another procCube; it is sent there. Every worker must pass `values` or none.
 pub fn deposit<T: Transport>(
     team: &mut Team<T>,
     region: &Region,
     points: &[[f64; 3]],
-    values: &[[f64; 2]],
+    values: Option<&[[f64; 2]]>,
 ) -> (Vec<bool>, Vec<[f64; 2]>) {
-    let with_values = !values.is_empty();
+    let with_values = values.is_some();
+    let values = values.unwrap_or(&[]);
+    assert!(
+        !with_values || values.len() == points.len(),
+        "one value pair per point"
+    );
     let mut marked = vec![false; region.len()];
     let mut sums = vec![[0.0; 2]; if with_values { region.len() } else { 0 }];
     let mut out: Vec<Vec<u8>> = vec![Vec::new(); team.size()];

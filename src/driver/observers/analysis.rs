@@ -73,10 +73,10 @@ impl<'a> Analysis<'a> {
 
     /// The points marked on the voxels, with their values: owned particles' positions
     /// (voids), or the midpoints of broken bonds with their opening (cracks).
-    fn points<M: Model>(&self, cube: &mut Cube<M>) -> (Vec<[f64; 3]>, Vec<[f64; 2]>) {
+    fn points<M: Model>(&self, cube: &mut Cube<M>) -> (Vec<[f64; 3]>, Option<Vec<[f64; 2]>>) {
         let p = &cube.sim.particles;
         match self.spec.kind {
-            AnalysisKind::Voids => ((0..p.n_owned).map(|i| p.pos(i)).collect(), Vec::new()),
+            AnalysisKind::Voids => ((0..p.n_owned).map(|i| p.pos(i)).collect(), None),
             AnalysisKind::Cracks => {
                 // Ghosts at the current positions (they are refreshed before each force
                 // evaluation anyway, so this changes nothing that follows).
@@ -96,7 +96,7 @@ impl<'a> Analysis<'a> {
                     mids.push([0, 1, 2].map(|d| 0.5 * (yi[d] + yj[d])));
                     values.push([length(yi, yj) - length(xi, xj), 1.0]);
                 }
-                (mids, values)
+                (mids, Some(values))
             }
         }
     }
@@ -129,7 +129,15 @@ impl<'a> Analysis<'a> {
                 }
             }
         });
-        VoxelGrid::spanning(self.spec.anchor, extent, self.spec.voxel)
+        // Crack voxels are shifted a quarter voxel off the lattice: bond midpoints lie on
+        // lattice sites or halfway between them, so none falls on a voxel face, where
+        // round-off (a different layout) could tip it either way.
+        let shift = match self.spec.kind {
+            AnalysisKind::Voids => 0.0,
+            AnalysisKind::Cracks => 0.25 * self.spec.voxel,
+        };
+        let anchor = self.spec.anchor.map(|x| x + shift);
+        VoxelGrid::spanning(anchor, extent, self.spec.voxel)
             .map_err(|e| format!("[[analysis]] '{}': {e}", self.spec.name))
     }
 
@@ -163,7 +171,7 @@ impl<M: Model> Observer<M> for Analysis<'_> {
         let grid = self.grid(cube)?;
         let region = self.region(cube, grid)?;
         let mut team = cube.team();
-        let (mut marked, sums) = deposit(&mut team, &region, &points, &values);
+        let (mut marked, sums) = deposit(&mut team, &region, &points, values.as_deref());
         if self.spec.kind == AnalysisKind::Voids {
             // Voids are the empty voxels.
             marked.iter_mut().for_each(|m| *m = !*m);

@@ -111,17 +111,18 @@ impl Converter {
         let mut analyses: Vec<AnalysisSpec> = Vec::new();
         for e in entries {
             let (a, line) = (e.get_ref(), self.line_of(e));
-            let kind =
-                match a.kind.as_str() {
-                    "voids" => AnalysisKind::Voids,
-                    "cracks" => AnalysisKind::Cracks,
-                    k => return self.err(
+            let kind = match a.kind.as_str() {
+                "voids" => AnalysisKind::Voids,
+                "cracks" => AnalysisKind::Cracks,
+                k => {
+                    return self.err(
                         line,
                         format!(
                             "[[analysis]] kind '{k}' is not known (use \"voids\" or \"cracks\")"
                         ),
-                    ),
-                };
+                    )
+                }
+            };
             let name = a.name.clone().unwrap_or_else(|| kind.name().to_string());
             if !valid_name(&name) {
                 return self.err(
