@@ -48,6 +48,24 @@ enum Cmd {
         #[arg(long)]
         title: Option<String>,
     },
+    /// Find the voids in a run's saved frames (DIR/frames/), as `[[analysis]] kind = "voids"`
+    /// does in situ: DIR/NAME.csv (one row per frame), DIR/NAME_clusters.csv,
+    /// DIR/NAME_events.csv, and the voxel labels as DIR/NAME_voxels.xdmf for ParaView.
+    Voids {
+        dir: PathBuf,
+        /// The voxel side in the run's units (for a lattice, its spacing; fcc: the cell side).
+        #[arg(long)]
+        voxel: f64,
+        /// "face" (6 neighbours, the default) or "all" (26).
+        #[arg(long, default_value = "face")]
+        connectivity: String,
+        /// Names the files.
+        #[arg(long, default_value = "voids_post")]
+        name: String,
+        /// Leave out the voxel labels (only the tables).
+        #[arg(long)]
+        no_labels: bool,
+    },
     /// Write a bondless deck's initial state (positions, velocities, one type per material)
     /// as a LAMMPS data file for `read_data`.
     LammpsData {
@@ -228,6 +246,10 @@ struct BenchArgs {
     /// checks, state pass, rotations, shuffling), `--rounds` times; prints a table.
     #[arg(long)]
     savings: bool,
+    /// Instead: the voids analysis's three label-merge schemes against procCubes (threads)
+    /// and the size of the largest void, `--rounds` times; prints a table.
+    #[arg(long)]
+    voids: bool,
 }
 
 /// The cores this process may use.
@@ -265,6 +287,13 @@ fn main() -> ExitCode {
                 false
             })
         }
+        Cmd::Voids {
+            dir,
+            voxel,
+            connectivity,
+            name,
+            no_labels,
+        } => post_voids(&dir, voxel, &connectivity, name, !no_labels).map(|()| false),
         Cmd::LammpsData { deck: path, output } => deck::load(&path)
             .map_err(|e| e.to_string())
             .and_then(|scene| pdq::driver::export::lammps_data(&scene))
@@ -411,6 +440,7 @@ fn bench_command(a: BenchArgs) -> Result<(), String> {
         rounds: a.rounds,
         checkpoint: a.checkpoint,
         savings: a.savings,
+        voids: a.voids,
     })?;
     print!("{s}");
     Ok(())
@@ -485,4 +515,58 @@ fn models_text() -> String {
         }
     }
     s
+}
+
+/// `pdq voids DIR`: the voids of a run's frames, afterwards.
+fn post_voids(
+    dir: &std::path::Path,
+    voxel: f64,
+    connectivity: &str,
+    name: String,
+    labels: bool,
+) -> Result<(), String> {
+    use pdq::voids::Connectivity;
+    let connectivity = match connectivity {
+        "face" => Connectivity::Face,
+        "all" => Connectivity::All,
+        c => {
+            return Err(format!(
+                "--connectivity '{c}' is not known (use \"face\": 6 neighbours, or \"all\": 26)"
+            ))
+        }
+    };
+    if !(voxel.is_finite() && voxel > 0.0) {
+        return Err(format!("--voxel must be a length > 0, got {voxel}"));
+    }
+    if !name
+        .chars()
+        .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        || name.is_empty()
+    {
+        return Err(format!(
+            "--name '{name}' must be letters, digits, '_' or '-'"
+        ));
+    }
+    let ask = pdq::driver::post::PostVoids {
+        voxel,
+        connectivity,
+        name,
+        labels,
+    };
+    let s = pdq::driver::post::voids_from_frames(dir, &ask)?;
+    println!(
+        "{} frames ({:.1} MB read) in {:.3} s: {} voids at the last; tables {}/{}*.csv{}",
+        s.frames,
+        s.bytes_read as f64 / 1e6,
+        s.seconds,
+        s.voids,
+        dir.display(),
+        ask.name,
+        if ask.labels {
+            format!(", voxel labels {}/{}_voxels.xdmf", dir.display(), ask.name)
+        } else {
+            String::new()
+        }
+    );
+    Ok(())
 }

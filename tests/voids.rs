@@ -456,6 +456,24 @@ fn a_block_with_holes_has_its_voids_on_every_layout() {
     assert!(joined["volume"] > 2.0 * ball(2.0 - h) + 20e-9, "{table}");
     let summary = rows(&one.join("voids.csv"), 1);
     assert_eq!(summary[0]["count"], 3.0);
+    // Afterwards from the frames (`pdq voids DIR`): the same table.
+    let framed = run_deck(
+        &deck.replace("picture = \"none\"", "picture = \"none\"\nframes_every = 1"),
+        "holes_frames",
+        [1, 1, 1],
+    );
+    let ask = pdq::driver::post::PostVoids {
+        voxel: 1e-3,
+        connectivity: Connectivity::Face,
+        name: "post".into(),
+        labels: true,
+    };
+    let post = pdq::driver::post::voids_from_frames(&framed, &ask).unwrap();
+    assert_eq!((post.frames, post.voids), (2, 3));
+    let again = std::fs::read_to_string(framed.join("post_clusters.csv")).unwrap();
+    assert!(again == table, "afterwards:\n{again}\nin situ:\n{table}");
+    assert!(framed.join("post_voxels.xdmf").exists());
+    std::fs::remove_dir_all(framed).unwrap();
     for (name, procs, scheme) in [
         ("holes2", [2, 1, 1], "boundary"),
         ("holes4", [2, 2, 1], "boundary"),

@@ -15,6 +15,7 @@ mod lj;
 mod peer;
 mod ranks;
 mod savings;
+mod voids;
 mod yardstick;
 
 use peer::{peer, peer_style};
@@ -50,6 +51,8 @@ pub struct BenchOptions {
     pub checkpoint: bool,
     /// Instead of the standard lines: what a scene saves by not using a feature.
     pub savings: bool,
+    /// Instead: the label-merge schemes of the voids analysis.
+    pub voids: bool,
 }
 
 const SPACING: f64 = 0.001;
@@ -157,6 +160,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 pub fn run(opts: &BenchOptions) -> Result<String, String> {
     if opts.threads.contains(&0) || opts.ranks.contains(&0) {
         return Err("threads and ranks must be at least 1".into());
+    }
+    if opts.voids {
+        return Ok(voids::schemes(opts.rounds));
     }
     if opts.savings {
         return savings(opts);

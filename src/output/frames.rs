@@ -60,6 +60,81 @@ pub fn frame_name(step: u64) -> String {
     format!("frames/frame_{step:08}.h5")
 }
 
+/// The steps of the frames in `dir/frames/`, in order.
+pub fn frame_steps(dir: &Path) -> Result<Vec<u64>, String> {
+    let mut steps: Vec<u64> = std::fs::read_dir(dir.join("frames"))
+        .map_err(|e| format!("{}: {e}", dir.join("frames").display()))?
+        .filter_map(|e| {
+            let name = e.ok()?.file_name().into_string().ok()?;
+            name.strip_prefix("frame_")?
+                .strip_suffix(".h5")?
+                .parse()
+                .ok()
+        })
+        .collect();
+    steps.sort_unstable();
+    Ok(steps)
+}
+
+/// The particles of a frame file: ids and current positions, with its step and time.
+pub struct FramePoints {
+    pub step: u64,
+    pub time: f64,
+    pub ids: Vec<i32>,
+    pub points: Vec<[f64; 3]>,
+}
+
+/// Reads a frame's ids and positions; a damaged or foreign file is an error naming it.
+pub fn read_points(path: &Path) -> Result<FramePoints, String> {
+    let read = || -> Result<FramePoints, String> {
+        let f =
+            hdf5_pure::File::open(path).map_err(|e| format!("not a readable HDF5 file ({e})"))?;
+        let a = f
+            .root()
+            .attrs()
+            .map_err(|e| format!("cannot read its attributes ({e})"))?;
+        let step = match a.get("step") {
+            Some(hdf5_pure::AttrValue::U64(s)) => *s,
+            _ => return Err("no 'step' attribute: not a PDQ frame".into()),
+        };
+        let time = match a.get("time") {
+            Some(hdf5_pure::AttrValue::F64(t)) => *t,
+            _ => return Err("no 'time' attribute: not a PDQ frame".into()),
+        };
+        let data = |name: &str| {
+            f.dataset(name)
+                .map_err(|e| format!("dataset '{name}' is missing or unreadable ({e})"))
+        };
+        let flat = data("points")?
+            .read_f64()
+            .map_err(|e| format!("dataset 'points': {e}"))?;
+        let ids = data("id")?
+            .read_i32()
+            .map_err(|e| format!("dataset 'id': {e}"))?;
+        if flat.len() != 3 * ids.len() {
+            return Err(format!(
+                "{} points for {} ids: the frame is damaged",
+                flat.len() / 3,
+                ids.len()
+            ));
+        }
+        let points = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        Ok(FramePoints {
+            step,
+            time,
+            ids,
+            points,
+        })
+    };
+    // The HDF5 reader may panic on a damaged file: that is an error here, not a crash.
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let r = std::panic::catch_unwind(read);
+    std::panic::set_hook(hook);
+    r.unwrap_or_else(|_| Err("the HDF5 reader failed on it: the file is damaged".into()))
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
 impl Frames {
     pub fn new(dir: &Path) -> std::io::Result<Frames> {
         std::fs::create_dir_all(dir.join("frames"))?;
@@ -74,18 +149,9 @@ impl Frames {
     /// checkpoint the run resumes from) are left out and overwritten when reached.
     pub fn resume(dir: &Path, step: u64, every: u64) -> Result<Frames, String> {
         let mut frames = Frames::new(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        let mut steps: Vec<u64> = std::fs::read_dir(dir.join("frames"))
-            .map_err(|e| format!("{}: {e}", dir.display()))?
-            .filter_map(|e| {
-                let name = e.ok()?.file_name().into_string().ok()?;
-                name.strip_prefix("frame_")?
-                    .strip_suffix(".h5")?
-                    .parse()
-                    .ok()
-            })
-            .filter(|&s: &u64| s <= step && s.is_multiple_of(every.max(1)))
-            .collect();
-        steps.sort_unstable();
+        let steps = frame_steps(dir)?
+            .into_iter()
+            .filter(|&s: &u64| s <= step && s.is_multiple_of(every.max(1)));
         for s in steps {
             let path = dir.join(frame_name(s));
             // A frame that cannot be read is left out of the series, not fatal.

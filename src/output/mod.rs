@@ -2,7 +2,8 @@
 //! ([`frames`]), checkpoints ([`checkpoint`]), files written atomically ([`atomic`]), progress
 //! on the terminal ([`progress`]), the signals that end a run cleanly ([`signals`]), PNG
 //! plots ([`plot`], [`curves`], the pictures of every run in [`pictures`]), LAMMPS data
-//! files ([`lammps_data`]) and the tables of the voids and cracks analyses ([`analysis`]).
+//! files ([`lammps_data`]), and the tables and voxel labels of the voids and cracks analyses
+//! ([`analysis`], [`voxels`]).
 
 pub mod analysis;
 pub mod atomic;
@@ -15,6 +16,7 @@ pub mod pictures;
 pub mod plot;
 pub mod progress;
 pub mod signals;
+pub mod voxels;
 
 pub use atomic::write_atomically;
 pub use frames::{frame_name, Frames};

@@ -1,8 +1,8 @@
 //! Pictures of a run's history, drawn at the end of every `pdq run` and by `pdq pictures DIR`
 //! from the output directory's `history.csv`: energies, broken bonds, each moving grip's load
 //! against its displacement, each held grip's reaction, each probe's displacement, and for
-//! molecular dynamics temperature and pressure; each applied load against time. They go to
-//! `DIR/pictures/`.
+//! molecular dynamics temperature and pressure; each applied load against time; and for each
+//! `[[analysis]]` its clusters' count and size against time. They go to `DIR/pictures/`.
 
 use super::curves::Columns;
 use super::plot::{xy, Mark, Series};
@@ -41,6 +41,60 @@ pub fn history_pictures(dir: &Path, title: &str) -> Result<Vec<PathBuf>, String>
             .collect();
         xy(&file, &p.title, &p.x, &p.y, &series)?;
         written.push(file);
+    }
+    written.extend(analysis_pictures(dir, title)?);
+    Ok(written)
+}
+
+/// For each analysis table (`NAME.csv` beside `NAME_events.csv`): its clusters' count, and
+/// their total and largest volume (voids) or area (cracks), against time.
+fn analysis_pictures(dir: &Path, title: &str) -> Result<Vec<PathBuf>, String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .filter_map(|e| {
+            let f = e.ok()?.file_name().into_string().ok()?;
+            Some(f.strip_suffix("_events.csv")?.to_string())
+        })
+        .collect();
+    names.sort();
+    let mut written = Vec::new();
+    for name in names {
+        let path = dir.join(format!("{name}.csv"));
+        let Ok(t) = Columns::read(&path) else {
+            continue;
+        };
+        if t.rows.len() < 2 {
+            continue;
+        }
+        let col = |c: &str| t.column(c, 1.0, &path);
+        let time = col("time")?;
+        let against = |y: Vec<f64>| time.iter().copied().zip(y).collect::<Vec<_>>();
+        let (what, total, largest) = if t.names.iter().any(|n| n == "porosity") {
+            ("volume", "volume", "largest_volume")
+        } else {
+            ("area", "area", "largest_area")
+        };
+        let count = [(name.clone(), against(col("count")?))];
+        let sizes = [
+            (format!("total {what}"), against(col(total)?)),
+            (format!("largest {what}"), against(col(largest)?)),
+        ];
+        for (file, y, curves) in [
+            (format!("{name}_count.png"), "count".to_string(), &count[..]),
+            (format!("{name}_{what}.png"), what.to_string(), &sizes[..]),
+        ] {
+            let file = dir.join("pictures").join(file);
+            let series: Vec<Series> = curves
+                .iter()
+                .map(|(n, points)| Series {
+                    name: n,
+                    points,
+                    mark: Mark::Line,
+                })
+                .collect();
+            xy(&file, &format!("{title}: {name}"), "time", &y, &series)?;
+            written.push(file);
+        }
     }
     Ok(written)
 }
