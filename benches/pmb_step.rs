@@ -16,6 +16,7 @@ fn main() {
         repeat: 5,
         checkpoint: true,
         savings: false,
+        voids: false,
     };
     match pdq::lab::bench::run(&opts) {
         Ok(s) => print!("{s}"),
