@@ -7,15 +7,17 @@
 //! - **Cracks**: a voxel holding the midpoint of a broken bond is marked; each cluster is a
 //!   crack, with its broken bonds and their mean opening.
 //!
-//! [`labels`] labels a grid cut into procCubes without gathering it (local union-find, then
+//! [`region`] is a procCube's share of the grid; [`labels`] labels a grid cut into procCubes without gathering it (local union-find, then
 //! the labels merged across procCube faces); [`find_voids`] is the same on one grid.
 //! [`tracking`] follows clusters from one analysis to the next.
 
 pub mod labels;
+pub mod region;
 pub mod tracking;
 mod union_find;
 
-pub use labels::{deposit, label, Labelled, Region, Scheme};
+pub use labels::{label, Labelled, Scheme};
+pub use region::{deposit, Region};
 
 /// A grid of voxels, periodic along some axes.
 #[derive(Clone, Debug, PartialEq)]
