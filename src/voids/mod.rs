@@ -286,6 +286,3 @@ impl VoidMap {
         }
     }
 }
-
-#[cfg(test)]
-mod tests;
