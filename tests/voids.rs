@@ -163,7 +163,7 @@ fn a_void_across_a_periodic_boundary_is_one_void() {
         Extent::Bounded { lo: 0.0, hi: 11.0 },
         Extent::Bounded { lo: 0.0, hi: 11.0 },
     ];
-    let grid = VoxelGrid::spanning([0.0; 3], extent, 1.0).unwrap();
+    let grid = VoxelGrid::spanning([0.0; 3], extent, [1.0; 3]).unwrap();
     assert_eq!(grid.dims, [30, 14, 14]);
     let removed = 30 * 12 * 12 - points.len();
     for w in [
@@ -190,7 +190,7 @@ fn a_fully_periodic_grid_has_no_outside() {
         origin: -0.5,
         period: 16.0,
     }; 3];
-    let grid = VoxelGrid::spanning([0.0; 3], extent, 1.0).unwrap();
+    let grid = VoxelGrid::spanning([0.0; 3], extent, [1.0; 3]).unwrap();
     assert!(!grid.has_outside());
     let (_, clusters, _) = labelled_on(
         &grid,
@@ -312,7 +312,7 @@ fn analyse(
     tracker: &mut Tracker,
 ) -> (Labelled, Vec<pdq::voids::tracking::Event>) {
     let extent = [Extent::Bounded { lo: 0.0, hi: 39.0 }; 3];
-    let grid = VoxelGrid::spanning([0.0; 3], extent, 1.0).unwrap();
+    let grid = VoxelGrid::spanning([0.0; 3], extent, [1.0; 3]).unwrap();
     let region = Region::whole(grid.clone());
     let mut team = Team::new(pdq::parallel::comm::Solo::new());
     let (occupied, _) = deposit(&mut team, &region, points, None);

@@ -79,7 +79,7 @@ pub fn voids_from_frames(dir: &Path, ask: &PostVoids) -> Result<PostSummary, Str
             lo: lo[a],
             hi: hi[a],
         });
-        let grid = VoxelGrid::spanning(anchor, extent, ask.voxel)
+        let grid = VoxelGrid::spanning(anchor, extent, [ask.voxel; 3])
             .map_err(|e| format!("{}: {e}", path.display()))?;
         let region = Region::whole(grid);
         let (occupied, _) = deposit(&mut team, &region, &frame.points, None);

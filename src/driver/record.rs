@@ -311,12 +311,14 @@ impl Thermo {
     }
 
     /// Temperature 2 KE/(dof k_B) and pressure (2 KE + W)/(3V), W = Σ x·F the virial of
-    /// the internal forces (LAMMPS's `compute pressure` with its `virial` of every style).
-    pub fn of(&self, row: &Row) -> [f64; 2] {
+    /// the internal forces (LAMMPS's `compute pressure` with its `virial` of every style), in
+    /// the box stretched by `stretch` along each axis (`[deform]`).
+    pub fn of(&self, row: &Row, stretch: [f64; 3]) -> [f64; 2] {
         let ke = row.kinetic_energy;
+        let volume = self.volume * stretch.iter().product::<f64>();
         [
             2.0 * ke / (self.dof * self.boltzmann),
-            (2.0 * ke + row.virial) / (3.0 * self.volume),
+            (2.0 * ke + row.virial) / (3.0 * volume),
         ]
     }
 }

@@ -328,6 +328,7 @@ impl<M: Model> Prepared<'_, M> {
             }),
             title: scene.title.clone(),
             analyses: analysis_plans(setup, scene),
+            deform: scene.deform.clone(),
         }
     }
 

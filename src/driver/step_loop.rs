@@ -6,6 +6,7 @@ use super::record::FrameStore;
 use super::run::Summary;
 use crate::engine::timing::Phase;
 use crate::model::Model;
+use crate::parallel::deform::Deform;
 use crate::parallel::snapshot::Snapshot;
 use crate::parallel::Cube;
 use crate::solve::{Adr, Explicit, Newton, Relaxed, Solver};
@@ -48,6 +49,8 @@ pub(crate) struct Plan {
     pub title: String,
     /// `[[analysis]]`: voids and cracks on voxels, in deck order.
     pub analyses: Vec<super::observers::analysis::AnalysisPlan>,
+    /// `[deform]`: the periodic box changing with time.
+    pub deform: Option<crate::input::deck::DeformSpec>,
 }
 
 /// When to write checkpoints, and what identifies them.
@@ -154,7 +157,7 @@ pub(crate) fn drive<M: Model>(
     resume: Option<&Snapshot>,
 ) -> Result<Option<Summary>, String> {
     let root = cube.wall.transport().rank() == 0;
-    start(&mut cube, resume);
+    start(&mut cube, plan, resume)?;
     let mut solver = plan.solver.start::<M>(root, plan.stop_at_broken);
     let first = plan.first_step;
     let tally = Tally {
@@ -188,9 +191,24 @@ pub(crate) fn drive<M: Model>(
     super::record::finish(cube, plan, watch.tally, seconds)
 }
 
-/// Restores a checkpoint's bonds, makes the bond counts whole, computes the first forces.
-fn start<M: Model>(cube: &mut Cube<M>, resume: Option<&Snapshot>) {
+/// Restores a checkpoint's bonds and box, makes the bond counts whole, computes the first
+/// forces.
+fn start<M: Model>(
+    cube: &mut Cube<M>,
+    plan: &Plan,
+    resume: Option<&Snapshot>,
+) -> Result<(), String> {
     let t = Instant::now();
+    if let Some(d) = &plan.deform {
+        let start = cube.layout.domain.clone();
+        cube.deform = Some(Deform::new(d.rate, d.every, start));
+        if let Some(c) = resume {
+            // The checkpoint's positions are in the box of its last change; the first step
+            // rebins.
+            let since = (c.step % d.every.max(1)) as f64 * cube.sim.dt;
+            cube.set_box(c.time - since)?;
+        }
+    }
     if let Some(c) = resume {
         c.restore_bonds(cube);
     }
@@ -199,6 +217,7 @@ fn start<M: Model>(cube: &mut Cube<M>, resume: Option<&Snapshot>) {
         c.restore_forces(cube);
     }
     cube.sim.timing.lap(Phase::Setup, t);
+    Ok(())
 }
 
 fn shuffle_when_due<M: Model>(

@@ -54,6 +54,10 @@ pub trait NonBonded<M: Model>: Send {
     /// Forgets where particles were at the last build, so that the next step rebuilds (after a
     /// restart put them elsewhere).
     fn invalidate(&mut self);
+    /// The box was stretched by `by` along each axis about `centre` (`[deform]`): the
+    /// positions at the last build are mapped along, so that only motion relative to the box
+    /// counts against the skin.
+    fn deformed(&mut self, centre: [f64; 3], by: [f64; 3]);
 }
 
 /// A half neighbour list with its skin, and the law it is evaluated with.
@@ -67,8 +71,10 @@ pub struct PairPass<L: PairLaw> {
     /// For each listed pair, the bond joining it when it was built (`NO_BOND`: none): the pair
     /// acts from the step its bond breaks, so that new crack faces touch without a rebuild.
     bond_of: Vec<u32>,
-    /// Owned positions at the last build.
+    /// Owned positions at the last build (mapped with a deforming box).
     at_build: Vec<[f64; 3]>,
+    /// How much a deforming box has stretched each axis since the last build.
+    stretched: [f64; 3],
     /// Scratch of the build: bond partners of each particle, both ways, with the bond's index.
     bonded_start: Vec<u32>,
     bonded: Vec<(u32, u32)>,
@@ -96,6 +102,7 @@ impl<L: PairLaw> PairPass<L> {
             partner: Vec::new(),
             bond_of: Vec::new(),
             at_build: Vec::new(),
+            stretched: [1.0; 3],
             bonded_start: Vec::new(),
             bonded: Vec::new(),
             mark: Vec::new(),
@@ -271,7 +278,15 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
         if self.at_build.len() != p.n_owned {
             return true;
         }
-        let limit = 0.25 * self.skin * self.skin;
+        // A box shrunk by λ < 1 since the build brought pairs closer by up to (1 − λ)·reach
+        // on top of their own motion: that much less skin is left for it.
+        let lambda = self.stretched.iter().fold(1.0f64, |m, &s| m.min(s));
+        let reach = self.law.cutoff() + self.skin;
+        let margin = self.skin - (1.0 - lambda) * reach;
+        if margin <= 0.0 {
+            return true;
+        }
+        let limit = 0.25 * margin * margin;
         (0..p.n_owned).any(|i| {
             let (a, b) = (pos(p, i), self.at_build[i]);
             let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
@@ -336,6 +351,7 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
         self.near.resize(longest as usize, Near::default());
         self.at_build.clear();
         self.at_build.extend((0..p.n_owned).map(|i| pos(p, i)));
+        self.stretched = [1.0; 3];
         self.builds += 1;
     }
 
@@ -357,6 +373,17 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
 
     fn invalidate(&mut self) {
         self.at_build.clear();
+    }
+
+    fn deformed(&mut self, centre: [f64; 3], by: [f64; 3]) {
+        for x in &mut self.at_build {
+            for a in 0..3 {
+                x[a] = centre[a] + (x[a] - centre[a]) * by[a];
+            }
+        }
+        for a in 0..3 {
+            self.stretched[a] *= by[a];
+        }
     }
 
     fn fresh(&self) -> Box<dyn NonBonded<M>> {

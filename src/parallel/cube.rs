@@ -40,6 +40,8 @@ pub struct Cube<M: Model> {
     /// Neighbour-list rebuilds that moved particles by migration, and by a shuffle (the same
     /// on every worker: the choice is collective).
     pub rebuilds: [u64; 2],
+    /// `[deform]`: the periodic box changing with time (set by the step loop).
+    pub deform: Option<crate::parallel::deform::Deform>,
 }
 
 /// Boundary conditions, loads and probes of the whole scene, by global id.
@@ -208,6 +210,7 @@ pub fn build_cube<M: Model>(
         everywhere,
         dropped: Vec::new(),
         rebuilds: [0; 2],
+        deform: None,
     }
 }
 
@@ -283,6 +286,7 @@ impl<M: Model> Cube<M> {
                 .thermostat_begin(&mut |v| team.reduce(v, crate::parallel::comm::Reduce::Sum));
         }
         self.sim.begin_step();
+        self.deform_box()?;
         if self.sim.pairs.is_some() {
             self.refresh_pairs()?;
         }

@@ -8,6 +8,7 @@ pub mod comm;
 pub mod comm_mpi;
 pub mod cube;
 pub mod decomposition;
+pub mod deform;
 mod migrate;
 pub mod shuffle;
 pub mod snapshot;

@@ -122,6 +122,13 @@ impl WallExchange {
         self.stages = stages;
     }
 
+    /// New periodic offsets of the stages, in order (a box that changed size).
+    pub fn set_shifts(&mut self, shifts: impl Iterator<Item = [f64; 3]>) {
+        for (st, s) in self.stages.iter_mut().zip(shifts) {
+            st.shift = s;
+        }
+    }
+
     pub fn stages(&self) -> &[Stage] {
         &self.stages
     }

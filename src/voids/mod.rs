@@ -122,19 +122,25 @@ impl VoxelGrid {
             lo: lo[a],
             hi: hi[a],
         });
-        VoxelGrid::spanning(first, extent, size)
+        VoxelGrid::spanning(first, extent, [size; 3])
     }
 
-    /// The grid of voxels of side `size` centred on `anchor`'s lattice, spanning each bounded
+    /// The grid of voxels of sides `size` centred on `anchor`'s lattice, spanning each bounded
     /// axis from `lo` to `hi` with one voxel of margin on each side, and each periodic axis
     /// exactly (there, voxels are stretched to a whole number per period).
-    pub fn spanning(anchor: [f64; 3], extent: [Extent; 3], size: f64) -> Result<VoxelGrid, String> {
-        if !(size.is_finite() && size > 0.0) {
-            return Err(format!("voxel size must be a positive length, got {size}"));
+    pub fn spanning(
+        anchor: [f64; 3],
+        extent: [Extent; 3],
+        size: [f64; 3],
+    ) -> Result<VoxelGrid, String> {
+        if !size.iter().all(|s| s.is_finite() && *s > 0.0) {
+            return Err(format!(
+                "voxel size must be a positive length, got {size:?}"
+            ));
         }
         let mut grid = VoxelGrid {
             origin: [0.0; 3],
-            size: [size; 3],
+            size,
             dims: [0; 3],
             periodic: [false; 3],
             offset: [0; 3],
@@ -149,14 +155,14 @@ impl VoxelGrid {
                     }
                     // Voxel boundaries half a voxel off the anchor's lattice, one voxel of
                     // margin below `lo` and above `hi`.
-                    let below = ((anchor[a] - lo) / size + 0.5).ceil();
-                    grid.origin[a] = anchor[a] - (below + 0.5) * size;
+                    let below = ((anchor[a] - lo) / size[a] + 0.5).ceil();
+                    grid.origin[a] = anchor[a] - (below + 0.5) * size[a];
                     grid.offset[a] = -(below as i64);
-                    let n = ((hi - grid.origin[a]) / size).floor() + 2.0;
+                    let n = ((hi - grid.origin[a]) / size[a]).floor() + 2.0;
                     grid.dims[a] = if n < 1e15 { n as usize } else { usize::MAX };
                 }
                 Extent::Periodic { origin, period } => {
-                    let n = (period / size).round().max(1.0);
+                    let n = (period / size[a]).round().max(1.0);
                     let s = period / n;
                     // The first voxel's centre in [origin, origin + s): centres run through
                     // the period in order.
@@ -176,8 +182,8 @@ impl VoxelGrid {
         match voxels {
             Some(v) if v <= 1 << 31 => Ok(grid),
             _ => Err(format!(
-                "{:?} voxels of {size:e} is more than 2^31: use larger voxels",
-                grid.dims
+                "{:?} voxels of {:e} is more than 2^31: use larger voxels",
+                grid.dims, size[0]
             )),
         }
     }

@@ -136,8 +136,15 @@ impl<'a> Analysis<'a> {
             AnalysisKind::Voids => 0.0,
             AnalysisKind::Cracks => 0.25 * self.spec.voxel,
         };
-        let anchor = self.spec.anchor.map(|x| x + shift);
-        VoxelGrid::spanning(anchor, extent, self.spec.voxel)
+        let mut anchor = self.spec.anchor.map(|x| x + shift);
+        let mut size = [self.spec.voxel; 3];
+        // In a deforming box the voxels stretch with it: the same voxels hold the same
+        // matter, so tracking matches them by place.
+        if let Some(d) = &cube.deform {
+            anchor = d.map(anchor);
+            size = [0, 1, 2].map(|a| size[a] * d.stretch()[a]);
+        }
+        VoxelGrid::spanning(anchor, extent, size)
             .map_err(|e| format!("[[analysis]] '{}': {e}", self.spec.name))
     }
 

@@ -57,7 +57,8 @@ impl<M: Model> Observer<M> for HistoryRows<'_> {
         let plan = self.plan;
         let damage = watch.damage(cube);
         let mut row = Row::reduced(cube, damage, plan.probe_stops.len());
-        row.thermo = plan.thermo.map(|t| t.of(&row));
+        let stretch = cube.deform.as_ref().map_or([1.0; 3], |d| d.stretch());
+        row.thermo = plan.thermo.map(|t| t.of(&row, stretch));
         // Every worker has the whole row, so all stop alike.
         let probe_halt = plan
             .probe_stops

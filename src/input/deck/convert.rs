@@ -102,6 +102,8 @@ impl Converter {
         let bonded = bondless.is_none();
         let bond_drops = (pair.is_some() && bonded) || parallel.shuffle_every > 0;
         let analyses = self.analyses(&deck.analysis, lattice.spacing, !bonded, bond_drops)?;
+        let pair_line = pair.as_ref().map(|p| p.line);
+        let deform = self.deform(deck.deform.as_ref(), periodic, !bonded, pair_line)?;
         Ok(Scene {
             file: self.file.clone(),
             periodic,
@@ -133,6 +135,7 @@ impl Converter {
             solver,
             pair,
             thermostat,
+            deform,
         })
     }
 

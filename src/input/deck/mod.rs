@@ -18,6 +18,7 @@
 mod bar;
 mod boundary;
 mod convert;
+mod deform;
 mod lattice;
 mod model;
 mod output;
@@ -32,9 +33,9 @@ mod time;
 
 pub use super::materials::MaterialLines;
 pub use spec::{
-    AnalysisKind, AnalysisSpec, BarSpec, BoundarySpec, Colouring, CriticalStep, InitialSpec,
-    LoadKind, LoadSpec, Located, ModelLines, OutputSpec, ParallelSpec, ProbeSpec, Region,
-    RunLength, Scene, SolverSpec, ThermostatKind, ThermostatSpec, TimeSpec, VelocitySpec,
+    AnalysisKind, AnalysisSpec, BarSpec, BoundarySpec, Colouring, CriticalStep, DeformSpec,
+    InitialSpec, LoadKind, LoadSpec, Located, ModelLines, OutputSpec, ParallelSpec, ProbeSpec,
+    Region, RunLength, Scene, SolverSpec, ThermostatKind, ThermostatSpec, TimeSpec, VelocitySpec,
 };
 
 use convert::{Converter, LineIndex};

@@ -47,6 +47,8 @@ pub(super) struct DeckFile {
     pub(super) pair: Option<Spanned<PairSection>>,
     #[serde(default)]
     pub(super) thermostat: Option<Spanned<ThermostatSection>>,
+    #[serde(default)]
+    pub(super) deform: Option<Spanned<DeformSection>>,
     /// What `pdq validate` reads (validation/README.md); a run ignores it.
     #[serde(default, rename = "validation")]
     pub(super) _validation: Option<toml::Table>,
@@ -260,6 +262,14 @@ pub(super) struct ThermostatSection {
     pub(super) every: Option<Spanned<i64>>,
     pub(super) region: Option<ShapeSpec>,
     pub(super) materials: Option<Spanned<Vec<String>>>,
+}
+
+/// `[deform]`: engineering strain rates of the periodic box, per unit time of the deck's units.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct DeformSection {
+    pub(super) strain_rate: Spanned<[f64; 3]>,
+    pub(super) every: Option<Spanned<i64>>,
 }
 
 #[derive(Deserialize, Default)]

@@ -282,6 +282,16 @@ pub struct AnalysisSpec {
     pub scheme: String,
 }
 
+/// `[deform]`: the periodic box's length along each axis is L0 (1 + rate·t), changed every
+/// `every` steps with the particles mapped along.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeformSpec {
+    pub line: usize,
+    /// Engineering strain rate per axis, per unit time (0 along non-periodic axes).
+    pub rate: [f64; 3],
+    pub every: u64,
+}
+
 /// A `[[bar]]` entry: the bar, the initial strain of its own bonds and its line.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BarSpec {
@@ -387,6 +397,8 @@ pub struct Scene {
     pub pair: Option<PairSpec>,
     /// `[thermostat]`, if the deck has one.
     pub thermostat: Option<ThermostatSpec>,
+    /// `[deform]`, if the deck has one.
+    pub deform: Option<DeformSpec>,
 }
 
 impl Scene {
