@@ -381,8 +381,8 @@ impl<M: Model, L: PairLaw> NonBonded<M> for PairPass<L> {
                 x[a] = centre[a] + (x[a] - centre[a]) * by[a];
             }
         }
-        for a in 0..3 {
-            self.stretched[a] *= by[a];
+        for (s, b) in self.stretched.iter_mut().zip(by) {
+            *s *= b;
         }
     }
 
