@@ -104,8 +104,8 @@ fn a_crystal_at_rest_in_a_growing_box_has_its_lattice_sums_row_by_row() {
         let c = columns(&dir);
         let n = 2048.0;
         let a0 = (4.0f64 / 1.0).cbrt();
-        for r in 0..c["time"].len() {
-            let stretch = 1.0 + rate * c["time"][r];
+        for (r, t) in c["time"].iter().enumerate() {
+            let stretch = 1.0 + rate * t;
             let a = a0 * stretch;
             let (energy, virial) = lattice_sums(a, 2.5);
             let volume = n * a.powi(3) / 4.0;
