@@ -88,6 +88,8 @@ fn quick_example_runs_and_cracks() {
         "load_displacement_grip_right_x.png",
         "reaction_grip_left_x.png",
         "probe_tip.png",
+        "cracks_count.png",
+        "cracks_area.png",
     ];
     for p in pictures {
         let file = dir.join("pictures").join(p);
@@ -95,6 +97,15 @@ fn quick_example_runs_and_cracks() {
         assert!(bytes.starts_with(b"\x89PNG") && bytes.len() > 10_000, "{p}");
     }
     assert!(dir.join("picture.png").exists(), "the damage picture");
+    // Where the largest cracks are: the largest is drawn in dark red (140, 10, 10).
+    let largest = dir.join("pictures/cracks_largest.png");
+    let mut reader = png::Decoder::new(std::fs::File::open(&largest).unwrap())
+        .read_info()
+        .unwrap();
+    let mut rgb = vec![0; reader.output_buffer_size()];
+    reader.next_frame(&mut rgb).unwrap();
+    let count = |c: [u8; 3]| rgb.chunks_exact(3).filter(|p| *p == c).count();
+    assert!(count([140, 10, 10]) > 5000, "the largest crack is drawn");
     std::fs::remove_dir_all(dir.join("pictures")).unwrap();
     let again = pdq::output::pictures::redraw(&dir, "again").unwrap();
     for p in pictures {

@@ -474,6 +474,14 @@ fn a_block_with_holes_has_its_voids_on_every_layout() {
     let again = std::fs::read_to_string(framed.join("post_clusters.csv")).unwrap();
     assert!(again == table, "afterwards:\n{again}\nin situ:\n{table}");
     assert!(framed.join("post_voxels.xdmf").exists());
+    // Where the largest are, in situ and afterwards.
+    for picture in ["voids_largest.png", "post_largest.png"] {
+        let bytes = std::fs::read(framed.join("pictures").join(picture)).unwrap();
+        assert!(
+            bytes.starts_with(b"\x89PNG") && bytes.len() > 5_000,
+            "{picture}"
+        );
+    }
     std::fs::remove_dir_all(framed).unwrap();
     for (name, procs, scheme) in [
         ("holes2", [2, 1, 1], "boundary"),

@@ -8,8 +8,10 @@
 
 use crate::output::analysis::{AnalysisFiles, Found, Looking};
 use crate::output::frames::{frame_name, frame_steps, read_points};
+use crate::output::pictures::{largest_clusters, LargestOf};
 use crate::output::voxels::VoxelSeries;
 use crate::parallel::comm::{Solo, Team};
+use crate::voids::largest::{largest, SHOWN};
 use crate::voids::tracking::Tracker;
 use crate::voids::{deposit, label, Connectivity, Extent, Region, Scheme, VoxelGrid, OCCUPIED};
 use std::path::Path;
@@ -119,6 +121,17 @@ pub fn voids_from_frames(dir: &Path, ask: &PostVoids) -> Result<PostSummary, Str
                 .map_err(io)?;
         }
         voids = found.clusters.len();
+        if Some(&frame.step) == steps.last() {
+            let of = LargestOf {
+                name: &ask.name,
+                title: &dir.display().to_string(),
+                what: "voids",
+                step: frame.step,
+                total: voids,
+            };
+            let shown = largest(&mut team, &region, &found, SHOWN).unwrap_or_default();
+            largest_clusters(dir, &of, &region.grid, &shown)?;
+        }
     }
     Ok(PostSummary {
         frames: steps.len(),

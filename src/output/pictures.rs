@@ -145,6 +145,64 @@ pub fn redraw(dir: &Path, title: &str) -> Result<Vec<PathBuf>, String> {
     Ok(files)
 }
 
+/// What a picture of the largest clusters shows: which analysis, of what, at which step.
+pub struct LargestOf<'a> {
+    /// The analysis's name: the picture is `pictures/NAME_largest.png`.
+    pub name: &'a str,
+    /// The run's title.
+    pub title: &'a str,
+    /// "voids" or "cracks".
+    pub what: &'a str,
+    pub step: u64,
+    /// Clusters found at that step.
+    pub total: usize,
+}
+
+/// Where the largest clusters are, in `dir/pictures/NAME_largest.png`: `voxels` (centre,
+/// place: 0 for the largest) drawn as cubes of the voxel's side, the largest dark red, the
+/// next ones through yellow to light blue, with the eight corners of the grid as dark blue
+/// cubes so that the view spans it. Side and oblique views, as the body's picture.
+pub fn largest_clusters(
+    dir: &Path,
+    of: &LargestOf,
+    grid: &crate::voids::VoxelGrid,
+    voxels: &[([f64; 3], usize)],
+) -> Result<PathBuf, String> {
+    const SHADE: [f64; 5] = [1.0, 0.8, 0.6, 0.4, 0.25];
+    let out = dir.join("pictures");
+    std::fs::create_dir_all(&out).map_err(|e| format!("creating {}: {e}", out.display()))?;
+    let (lo, side) = (grid.origin, grid.size);
+    let hi = [0, 1, 2].map(|a| lo[a] + grid.dims[a] as f64 * side[a]);
+    let mut x0: Vec<[f64; 3]> = (0..8)
+        .map(|k| [0, 1, 2].map(|a| if k >> a & 1 == 0 { lo[a] } else { hi[a] }))
+        .collect();
+    let mut value = vec![0.0; 8];
+    for (c, place) in voxels {
+        x0.push(*c);
+        value.push(SHADE[(*place).min(SHADE.len() - 1)]);
+    }
+    let side = side.iter().fold(f64::INFINITY, |m, &s| m.min(s));
+    let shown = voxels.iter().map(|v| v.1 + 1).max().unwrap_or(0);
+    let title = format!(
+        "{}: {} at step {}, the {shown} largest of {} (dark red: largest), voxels of {side:.3e}",
+        of.title, of.what, of.step, of.total
+    );
+    let path = out.join(format!("{}_largest.png", of.name));
+    super::plot::particle_views(
+        &path,
+        &title,
+        &super::plot::Body {
+            x0: &x0,
+            displacement: &vec![[0.0; 3]; x0.len()],
+            value: &value,
+            spacing: side,
+            scale: ["grid corners".into(), "largest".into()],
+        },
+        1.0,
+    )?;
+    Ok(path)
+}
+
 /// The spacing of `n` particles filling their bounding box (a particle's square in a picture).
 fn typical_spacing(position: &[[f64; 3]]) -> f64 {
     let mut lo = [f64::INFINITY; 3];

@@ -9,9 +9,11 @@
 //!
 //! [`region`] is a procCube's share of the grid; [`labels`] labels a grid cut into procCubes without gathering it (local union-find, then
 //! the labels merged across procCube faces); [`find_voids`] is the same on one grid.
-//! [`tracking`] follows clusters from one analysis to the next.
+//! [`tracking`] follows clusters from one analysis to the next; [`largest`] gathers the largest
+//! ones' voxels for a picture.
 
 pub mod labels;
+pub mod largest;
 pub mod region;
 pub mod tracking;
 mod union_find;

@@ -10,8 +10,10 @@ use crate::engine::timing::Phase;
 use crate::input::deck::AnalysisKind;
 use crate::model::Model;
 use crate::output::analysis::{AnalysisFiles, Found, Looking};
+use crate::output::pictures::{largest_clusters, LargestOf};
 use crate::parallel::comm::Reduce;
 use crate::parallel::Cube;
+use crate::voids::largest::{largest, SHOWN};
 use crate::voids::tracking::Tracker;
 use crate::voids::{deposit, label, Connectivity, Extent, Region, Scheme, VoxelGrid};
 use std::ops::ControlFlow;
@@ -186,6 +188,21 @@ impl<M: Model> Observer<M> for Analysis<'_> {
         let s = self.spec;
         let found = label(&mut team, &region, &marked, &sums, s.connectivity, s.scheme);
         let (events, ids) = self.tracker.follow(&mut team, &region, &found);
+        if watch.last {
+            let shown = largest(&mut team, &region, &found, SHOWN);
+            if let (Some(voxels), Some(_)) = (shown, &self.files) {
+                let of = LargestOf {
+                    name: &self.spec.name,
+                    title: &self.plan.title,
+                    what: self.spec.kind.name(),
+                    step: watch.step,
+                    total: found.clusters.len(),
+                };
+                if let Err(e) = largest_clusters(&self.plan.dir, &of, &region.grid, &voxels) {
+                    watch.error = Some(e);
+                }
+            }
+        }
         if let Some(files) = &mut self.files {
             let row = Found {
                 step: watch.step,
