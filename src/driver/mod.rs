@@ -11,3 +11,4 @@ pub mod post;
 mod record;
 pub mod run;
 mod step_loop;
+mod thermo;

@@ -1,8 +1,9 @@
 //! `pdq run` and `pdq check`: drive a simulation built from a deck and report on it.
 
 use super::observers::analysis::AnalysisPlan;
-use super::record::{columns, frame_store, Thermo};
+use super::record::{columns, frame_store};
 use super::step_loop::{drive, CheckpointPlan, Plan, SolverChoice};
+use super::thermo::Thermo;
 use crate::input::deck::{Colouring, Scene, SolverSpec};
 use crate::input::setup::{self, Setup};
 use crate::model::{Model, ModelVisitor};

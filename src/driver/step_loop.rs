@@ -42,7 +42,7 @@ pub(crate) struct Plan {
     pub spacing: f64,
     pub checkpoints: CheckpointPlan,
     /// With a pair law: how rows get their temperature and pressure.
-    pub thermo: Option<super::record::Thermo>,
+    pub thermo: Option<super::thermo::Thermo>,
     /// `[output] picture`: what `picture.png` of the final state is coloured by.
     pub picture: Option<crate::input::deck::Colouring>,
     /// The deck's title, for the picture.
