@@ -286,12 +286,12 @@ impl<M: Model> Cube<M> {
                 .thermostat_begin(&mut |v| team.reduce(v, crate::parallel::comm::Reduce::Sum));
         }
         self.sim.begin_step();
-        self.deform_box()?;
         if self.sim.pairs.is_some() {
             self.refresh_pairs()?;
         }
         let broken = self.sim.compute_forces_with(&mut self.wall);
         self.sim.end_step();
+        self.deform_box()?;
         if self.sim.thermostat.is_some() {
             let mut team = Team::new(self.wall.transport());
             self.sim

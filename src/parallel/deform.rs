@@ -1,7 +1,8 @@
 //! A periodic box that changes with time (`[deform]`, as LAMMPS's `fix deform … erate …
 //! remap x`): each axis's length is L(t) = L0 (1 + rate·t) about the box's fixed centre, and
-//! the particles are mapped with it (affinely, velocities unchanged). Every `every` steps the
-//! procCubes stretch their cells and the owned positions alike, and their ghost messages add
+//! the particles are mapped with it (affinely, velocities unchanged). At the end of every
+//! `every`-th step (after the second half-kick, where LAMMPS's fix changes the box, so that the
+//! two codes agree to round-off) the procCubes stretch their cells and the owned positions alike, and their ghost messages add
 //! the new periods to the images they bring. The neighbour lists stay until the particles
 //! have moved half the skin *relative to the box* (the list's reference positions are mapped
 //! too), as in LAMMPS; a shrinking box spends part of the skin, which the list accounts for.
