@@ -49,10 +49,16 @@ pub(crate) fn describe<M: Model>(setup: &Setup<M>, scene: &Scene) -> String {
             "           (not counting bonds across periodic faces: the procCubes add those; the run's total is in timing.txt)"
         );
     }
+    let e = &setup.memory;
+    let free = setup::memory::available().map_or(String::new(), |(b, _)| {
+        format!(", {:.0} MiB free", b / 1048576.0)
+    });
     let _ = writeln!(
         s,
-        "memory     {:.1} MiB (particles and bonds)",
-        mem as f64 / 1048576.0
+        "memory     {:.1} MiB (particles and bonds); estimated before building: {:.1} MiB of records, {:.1} MiB at the peak of setup per process{free}",
+        mem as f64 / 1048576.0,
+        e.records / 1048576.0,
+        e.peak / 1048576.0
     );
     let critical = match setup.dt_measured {
         Some((dt, evaluations)) => format!(

@@ -681,6 +681,10 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
     Ok(cloud)
 }
 
+#[path = "geometry_count.rs"]
+mod count;
+pub use count::{count_particles, neighbours_within};
+
 #[cfg(test)]
 #[path = "geometry_tests.rs"]
 mod tests;

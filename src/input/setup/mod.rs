@@ -14,6 +14,7 @@ use crate::model::{Model, ModelBuild, ModelVisitor};
 use std::time::Instant;
 
 mod maxwell;
+pub mod memory;
 mod pairs;
 mod place;
 mod thermostat;
@@ -44,6 +45,8 @@ pub struct Setup<M: Model> {
     pub solver: crate::input::deck::SolverSpec,
     /// Calibration factors and prestrain of the bars' own bonds.
     pub bars: BarBonds,
+    /// What the memory guard estimated before building.
+    pub memory: memory::Estimate,
 }
 
 impl<M: Model> Setup<M> {
@@ -71,6 +74,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     let start = Instant::now();
     let pair_pass = pairs::pair_pass(&model, scene)?;
     let reach = pair_pass.as_ref().map_or(0.0, |p| p.reach());
+    let memory = memory::guard::<M>(scene, reach)?;
     let (mut particles, cloud_bar, domain, gid_to_index) = particles(&model, scene, reach)?;
     let (bonds, correction, bars) = bonds(&model, &mut particles, scene, cloud_bar)?;
     let (dt_critical, dt_critical_particle) = stable_time_step(&model, &particles, &bonds);
@@ -132,6 +136,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         correction,
         solver: scene.solver.item.clone(),
         bars,
+        memory,
     })
 }
 

@@ -1,0 +1,129 @@
+//! The memory guard (issue 25): before the scene is built, how much memory building it will
+//! take, against what this process may have. A scene that will not fit is refused with the
+//! numbers and the remedies, never an allocation abort or the kernel's kill.
+//!
+//! The estimate counts the lattice sites the geometry fills (without storing them) and gives
+//! every particle the bonds of an interior one (a bound: surface particles have fewer), and the
+//! pairs of its neighbour list with a pair law. Setup holds its temporaries beside the records:
+//! the peak resident memory of `pdq check` and `pdq run` measured 2.04–2.07 times the particle
+//! and bond records (492,500 PMB particles, 28.4 million bonds: 1.29 GB against 632 MiB), so
+//! the estimate is 2.1 times them. Every worker builds the whole scene today, so each MPI rank
+//! needs all of it: ranks sharing a machine multiply it.
+
+use crate::engine::bonds::BondList;
+use crate::engine::particles::Particles;
+use crate::input::deck::{DeckError, Scene};
+use crate::input::geometry;
+use crate::model::Model;
+
+/// Peak resident memory over the particle and bond records, as measured (module doc).
+const PEAK_OVER_RECORDS: f64 = 2.1;
+
+/// What building the scene will take.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Estimate {
+    pub particles: f64,
+    /// Bonds, stored once: particles × interior bonds / 2.
+    pub bonds: f64,
+    /// Neighbour-list pairs (with a pair law), stored once.
+    pub pairs: f64,
+    /// Bytes of the particle, bond and pair records.
+    pub records: f64,
+    /// Bytes at the peak of setup, per worker process.
+    pub peak: f64,
+}
+
+/// Counts the scene and estimates its memory for model `M`; `reach` is the pair law's cutoff
+/// + skin (0 without one). `None` if the geometry is one the builder refuses (it says why).
+pub fn estimate<M: Model>(scene: &Scene, reach: f64) -> Option<Estimate> {
+    let lattice = &scene.lattice;
+    let particles = geometry::count_particles(
+        &scene.lattice,
+        &scene.geometry_ops(),
+        &scene.geometry_bars(),
+    )?;
+    let per_bond = if M::BONDED {
+        geometry::neighbours_within(lattice, scene.horizon) as f64
+    } else {
+        0.0
+    };
+    let per_pair = geometry::neighbours_within(lattice, reach) as f64;
+    let (bonds, pairs) = (0.5 * particles * per_bond, 0.5 * particles * per_pair);
+    let records = particles * Particles::<M>::bytes_per_particle() as f64
+        + bonds * BondList::<M::Bond>::bytes_per_bond() as f64
+        + pairs * 8.0;
+    Some(Estimate {
+        particles,
+        bonds,
+        pairs,
+        records,
+        peak: PEAK_OVER_RECORDS * records,
+    })
+}
+
+/// Bytes this process may still allocate, and where the figure comes from: the smaller of the
+/// cgroup's limit less its usage and the kernel's MemAvailable. `None` if neither is readable.
+pub fn available() -> Option<(f64, &'static str)> {
+    let read = |p: &str| std::fs::read_to_string(p).ok();
+    let cgroup = read("/sys/fs/cgroup/memory.max")
+        .and_then(|m| m.trim().parse::<f64>().ok())
+        .map(|limit| {
+            let used = read("/sys/fs/cgroup/memory.current")
+                .and_then(|u| u.trim().parse::<f64>().ok())
+                .unwrap_or(0.0);
+            (limit - used, "the cgroup's memory.max less memory.current")
+        });
+    let meminfo = read("/proc/meminfo").and_then(|m| {
+        let line = m.lines().find(|l| l.starts_with("MemAvailable:"))?;
+        let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some((kb * 1024.0, "MemAvailable in /proc/meminfo"))
+    });
+    match (cgroup, meminfo) {
+        (Some(c), Some(m)) => Some(if c.0 < m.0 { c } else { m }),
+        (c, m) => c.or(m),
+    }
+}
+
+/// Worker processes of this run on this machine: MPI ranks here (as Open MPI and MPICH tell
+/// them), else 1 (threads share one process).
+fn processes_here() -> f64 {
+    ["OMPI_COMM_WORLD_LOCAL_SIZE", "MPI_LOCALNRANKS"]
+        .iter()
+        .find_map(|v| std::env::var(v).ok()?.parse::<f64>().ok())
+        .unwrap_or(1.0)
+        .max(1.0)
+}
+
+/// The estimate, or an error with the numbers and the remedies when the scene will not fit in
+/// what the process may have.
+pub fn guard<M: Model>(scene: &Scene, reach: f64) -> Result<Estimate, DeckError> {
+    let Some(e) = estimate::<M>(scene, reach) else {
+        // The builder reports what is wrong with the geometry.
+        return Ok(Estimate::default());
+    };
+    let Some((free, source)) = available() else {
+        return Ok(e);
+    };
+    let here = processes_here();
+    if e.peak * here <= free {
+        return Ok(e);
+    }
+    let gib = |b: f64| b / (1u64 << 30) as f64;
+    let ranks = if here > 1.0 {
+        format!(" × {here} ranks on this machine")
+    } else {
+        String::new()
+    };
+    Err(scene.error(
+        None,
+        format!(
+            "the scene will not fit in memory: {:.3e} particles and about {:.3e} bonds{} need about {:.1} GiB to set up ({:.1} GiB of particle and bond records × {PEAK_OVER_RECORDS}, the measured peak of setup){ranks}, and this process may have {:.1} GiB ({source}). Nothing was allocated. Remedies: a coarser lattice (twice the spacing: 1/8 of the particles and bonds), a smaller horizon (m = 3 → 2: about 1/3.4 of the bonds), fewer or smaller [[geometry]] entries, or a machine with more memory; more MPI ranks do not help yet, as every rank builds the whole scene",
+            e.particles,
+            e.bonds,
+            if e.pairs > 0.0 { format!(" and {:.3e} neighbour pairs", e.pairs) } else { String::new() },
+            gib(e.peak),
+            gib(e.records),
+            gib(free)
+        ),
+    ))
+}
