@@ -541,6 +541,47 @@ fn scene_err(message: String) -> GeometryError {
 /// Site keys are [k, j, i] so BTreeMap order is the documented (z, y, x) order, x fastest.
 type Key = [i64; 3];
 
+/// How keys place a lattice's sites: keys count whole cells on the simple-cubic lattice (sites
+/// at their centres) and half cells on fcc and bcc (sites on the planes), where `admits` picks
+/// the sites.
+struct Keys {
+    origin: Vec3,
+    /// Distance between keys, and the sites' offset from the keys in those steps.
+    step: f64,
+    shift: f64,
+    /// Shapes select sites within this of their surface.
+    tol: f64,
+    /// fcc and bcc boxes leave out the sites on their upper faces.
+    half_open: bool,
+}
+
+impl Keys {
+    fn of(lattice: &Lattice) -> Keys {
+        let s = lattice.spacing;
+        let (step, shift) = match lattice.kind {
+            LatticeKind::Sc => (s, 0.5),
+            LatticeKind::Fcc | LatticeKind::Bcc => (0.5 * s, 0.0),
+        };
+        Keys {
+            origin: lattice.origin,
+            step,
+            shift,
+            tol: 1e-9 * s,
+            half_open: lattice.kind != LatticeKind::Sc,
+        }
+    }
+
+    fn site(&self, key: &Key) -> Vec3 {
+        [0, 1, 2].map(|e| self.origin[e] + self.step * (key[2 - e] as f64 + self.shift))
+    }
+
+    /// Index ranges (padded by one) of the sites covering [lo, hi]; inside tests trim them.
+    fn around(&self, lo: Vec3, hi: Vec3) -> [(f64, f64); 3] {
+        let idx = |x: f64, e: usize| (x - self.origin[e]) / self.step - self.shift;
+        [0, 1, 2].map(|e| (idx(lo[e], e).floor() - 1.0, idx(hi[e], e).ceil() + 1.0))
+    }
+}
+
 /// Keys of all sites in inclusive index ranges given per axis (x, y, z).
 fn sites(r: [(f64, f64); 3]) -> impl Iterator<Item = Key> {
     let r = r.map(|(a, b)| a as i64..=b as i64);
@@ -568,21 +609,10 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
             lattice.jitter
         )));
     }
-    let tol = 1e-9 * s;
-    let kind = lattice.kind;
-    let half_open = kind != LatticeKind::Sc;
-    // Keys count whole cells on the simple-cubic lattice (sites at their centres) and half
-    // cells on fcc and bcc (sites on the planes), where `admits` picks the sites.
-    let (step, shift) = match kind {
-        LatticeKind::Sc => (s, 0.5),
-        LatticeKind::Fcc | LatticeKind::Bcc => (0.5 * s, 0.0),
-    };
-    let site = |key: &Key| [0, 1, 2].map(|e| o[e] + step * (key[2 - e] as f64 + shift));
-    // Index ranges (padded by one) of the sites covering [lo, hi]; inside tests trim them.
-    let range = |lo: Vec3, hi: Vec3| {
-        let idx = |x: f64, e: usize| (x - o[e]) / step - shift;
-        [0, 1, 2].map(|e| (idx(lo[e], e).floor() - 1.0, idx(hi[e], e).ceil() + 1.0))
-    };
+    let keys = Keys::of(lattice);
+    let (tol, half_open, kind) = (keys.tol, keys.half_open, lattice.kind);
+    let site = |key: &Key| keys.site(key);
+    let range = |lo: Vec3, hi: Vec3| keys.around(lo, hi);
     let sites = |r| sites(r).filter(move |key| kind.admits(key));
     let mut filled: BTreeMap<Key, u16> = BTreeMap::new();
     for (n, op) in ops.iter().enumerate() {

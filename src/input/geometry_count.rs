@@ -3,7 +3,7 @@
 //! `Subtract`) fills it too, which is the overlap rule of [`super::build`]. Bars add their
 //! particle counts (the few lattice sites they displace are not taken off: an upper bound).
 
-use super::{all_finite, sites, Bar, Key, Lattice, LatticeKind, Op};
+use super::{all_finite, sites, Bar, Keys, Lattice, Op};
 
 /// Particles of the scene `build` would make, counted site by site; `None` when an entry is
 /// one `build` refuses (it reports the reason).
@@ -12,14 +12,8 @@ pub fn count_particles(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Option<f6
     if !(s.is_finite() && s > 0.0 && all_finite(&o)) {
         return None;
     }
-    let tol = 1e-9 * s;
-    let kind = lattice.kind;
-    let half_open = kind != LatticeKind::Sc;
-    let (step, shift) = match kind {
-        LatticeKind::Sc => (s, 0.5),
-        LatticeKind::Fcc | LatticeKind::Bcc => (0.5 * s, 0.0),
-    };
-    let site = |key: &Key| [0, 1, 2].map(|e| o[e] + step * (key[2 - e] as f64 + shift));
+    let keys = Keys::of(lattice);
+    let (tol, half_open, kind) = (keys.tol, keys.half_open, lattice.kind);
     let mut total = 0.0;
     for (n, op) in ops.iter().enumerate() {
         let Op::Add { shape, .. } = op else {
@@ -30,15 +24,14 @@ pub fn count_particles(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Option<f6
         if !all_finite(&[lo, hi].concat()) {
             return None;
         }
-        let idx = |x: f64, e: usize| (x - o[e]) / step - shift;
-        let r = [0, 1, 2].map(|e| (idx(lo[e], e).floor() - 1.0, idx(hi[e], e).ceil() + 1.0));
+        let r = keys.around(lo, hi);
         if r.iter().map(|(a, b)| b - a + 1.0).product::<f64>() > u32::MAX as f64 {
             return None;
         }
         let later = &ops[n + 1..];
         total += sites(r)
             .filter(|key| kind.admits(key))
-            .map(|key| site(&key))
+            .map(|key| keys.site(&key))
             .filter(|p| shape.fills(*p, tol, half_open))
             .filter(|p| {
                 !later.iter().any(|l| {
@@ -58,11 +51,7 @@ pub fn neighbours_within(lattice: &Lattice, radius: f64) -> usize {
     if !(radius > 0.0 && s > 0.0 && radius.is_finite()) {
         return 0;
     }
-    // Keys count cells (sc) or half cells (fcc, bcc) as in `build`.
-    let step = match lattice.kind {
-        LatticeKind::Sc => s,
-        LatticeKind::Fcc | LatticeKind::Bcc => 0.5 * s,
-    };
+    let step = Keys::of(lattice).step;
     let n = (radius / step).ceil() + 1.0;
     sites([(-n, n); 3])
         .filter(|key| lattice.kind.admits(key) && *key != [0, 0, 0])

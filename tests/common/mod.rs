@@ -188,3 +188,30 @@ pub fn max_distance(a: &[[f64; 3]], b: &[[f64; 3]], period: f64) -> f64 {
         })
         .fold(0.0, f64::max)
 }
+
+/// The head of an lj deck: `cells`³ fcc cells at reduced density `density` (mass 1 per atom),
+/// periodic along x, y and z, material `argon`, bondless point particles, the box's upper faces
+/// `trim` below the whole cells (half-open boxes leave their sites out either way). The
+/// sections that follow are the test's.
+#[allow(dead_code)]
+pub fn fcc_box(density: f64, cells: usize, trim: f64) -> String {
+    let a = (4.0 / density).cbrt();
+    format!(
+        r#"units = "lj"
+[model]
+name = "point"
+[lattice]
+kind = "fcc"
+density = {density}
+periodic = ["x", "y", "z"]
+[materials.argon]
+density = {density}
+[[geometry]]
+shape = "box"
+material = "argon"
+min = [0, 0, 0]
+max = [{l}, {l}, {l}]
+"#,
+        l = cells as f64 * a - trim
+    )
+}

@@ -11,26 +11,13 @@ use std::path::PathBuf;
 /// An lj deck of 8 × 8 × 8 fcc cells at density 1.0, periodic, LJ cut at 2.5 σ, 200 steps of
 /// 0.005 τ, the box growing at `rate` per τ along each axis, with `extra` appended.
 fn deck(rate: f64, extra: &str) -> String {
+    let head = crate::common::fcc_box(1.0, 8, 0.05);
     format!(
-        r#"units = "lj"
-[model]
-name = "point"
-[lattice]
-kind = "fcc"
-density = 1.0
-periodic = ["x", "y", "z"]
-[materials.solid]
-density = 1.0
-[[geometry]]
-shape = "box"
-material = "solid"
-min = [0, 0, 0]
-max = [12.65, 12.65, 12.65]
-[pair]
+        r#"{head}[pair]
 law = "lj"
 cutoff = 2.5
 skin = 0.3
-[pair.materials.solid]
+[pair.materials.argon]
 epsilon = 1.0
 sigma = 1.0
 [deform]

@@ -9,28 +9,8 @@ use pdq::models::point::Point;
 
 /// An lj deck of `cells`³ fcc cells at reduced density 0.8442, periodic along x, y and z.
 fn fcc_deck(cells: usize, extra: &str) -> String {
-    let a = (4.0f64 / 0.8442).cbrt();
-    format!(
-        r#"units = "lj"
-[model]
-name = "point"
-[lattice]
-kind = "fcc"
-density = 0.8442
-periodic = ["x", "y", "z"]
-[materials.argon]
-density = 0.8442
-[[geometry]]
-shape = "box"
-material = "argon"
-min = [0, 0, 0]
-max = [{l}, {l}, {l}]
-[time]
-dt = 0.005
-steps = 10
-{extra}"#,
-        l = cells as f64 * a
-    )
+    let head = crate::common::fcc_box(0.8442, cells, 0.0);
+    format!("{head}[time]\ndt = 0.005\nsteps = 10\n{extra}")
 }
 
 fn scene(text: &str) -> Result<deck::Scene, String> {

@@ -13,23 +13,9 @@ use std::path::PathBuf;
 /// 500 LJ atoms: 5³ fcc cells at ρ* = 0.8442 in a periodic box, LJ cut at 2.5σ and shifted (so
 /// that the energy has no jumps at the cutoff), Maxwell–Boltzmann start at `t_start`.
 fn lj_deck(t_start: f64, steps: u64, extra: &str) -> String {
-    let a = (4.0f64 / 0.8442).cbrt();
+    let head = crate::common::fcc_box(0.8442, 5, 0.01);
     format!(
-        r#"units = "lj"
-[model]
-name = "point"
-[lattice]
-kind = "fcc"
-density = 0.8442
-periodic = ["x", "y", "z"]
-[materials.argon]
-density = 0.8442
-[[geometry]]
-shape = "box"
-material = "argon"
-min = [0, 0, 0]
-max = [{l}, {l}, {l}]
-[velocity]
+        r#"{head}[velocity]
 temperature = {t_start}
 seed = 87287
 [pair]
@@ -45,8 +31,7 @@ dt = 0.005
 steps = {steps}
 [output]
 progress = false
-{extra}"#,
-        l = 5.0 * a - 0.01
+{extra}"#
     )
 }
 
