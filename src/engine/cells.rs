@@ -47,12 +47,17 @@ impl CellGrid {
             lo = [0.0; 3];
             hi = [0.0; 3];
         }
+        CellGrid::covering_box(lo, hi, points.len(), min_size)
+    }
+
+    /// Cells of side ≥ `min_size` covering the box `[lo, hi]` of `points` points.
+    pub fn covering_box(lo: [f64; 3], hi: [f64; 3], points: usize, min_size: f64) -> CellGrid {
         // Cells a hair larger than asked: with a side of exactly the horizon, rounding in
         // `coords` could put a pair at exactly the horizon two cells apart.
         let mut target = min_size * (1.0 + 1e-9);
         // A sparse scene (two bodies far apart, a long diagonal bar) would need more cells than
         // memory holds; larger cells stay correct, as only size >= horizon matters.
-        let cap = (8 * points.len()).max(4096) as f64;
+        let cap = (8 * points).max(4096) as f64;
         loop {
             let mut dims = [1usize; 3];
             let mut size = [target; 3];

@@ -597,20 +597,8 @@ fn sites(r: [(f64, f64); 3]) -> impl Iterator<Item = Key> {
 /// overlap rules. Each Add visits only the sites in its shape's bounding box; bar/site overlap
 /// is found by indexing the lattice around each bar particle, O(M log N) rather than O(N·M).
 pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, GeometryError> {
-    let (s, o) = (lattice.spacing, lattice.origin);
-    if !(s.is_finite() && s > 0.0 && all_finite(&o)) {
-        return Err(scene_err(format!(
-            "lattice spacing must be finite and > 0, origin finite (got spacing {s}, origin {o:?})"
-        )));
-    }
-    if !(0.0..0.5).contains(&lattice.jitter) {
-        return Err(scene_err(format!(
-            "lattice jitter must be in [0, 0.5) spacings (got {})",
-            lattice.jitter
-        )));
-    }
-    let keys = Keys::of(lattice);
-    let (tol, half_open, kind) = (keys.tol, keys.half_open, lattice.kind);
+    let keys = scene_sites::check_lattice(lattice)?;
+    let (s, tol, half_open, kind) = (lattice.spacing, keys.tol, keys.half_open, lattice.kind);
     let site = |key: &Key| keys.site(key);
     let range = |lo: Vec3, hi: Vec3| keys.around(lo, hi);
     let sites = |r| sites(r).filter(move |key| kind.admits(key));
@@ -714,6 +702,9 @@ pub fn build(lattice: &Lattice, ops: &[Op], bars: &[Bar]) -> Result<Cloud, Geome
 #[path = "geometry_count.rs"]
 mod count;
 pub use count::{count_particles, neighbours_within};
+#[path = "geometry_sites.rs"]
+mod scene_sites;
+pub use scene_sites::{SceneSites, Site};
 
 #[cfg(test)]
 #[path = "geometry_tests.rs"]

@@ -354,3 +354,46 @@ fn simple_cubic_is_unchanged_by_the_lattice_kinds() {
     assert_eq!(cloud.position[0], [0.5, 0.5, 0.5]);
     assert_eq!(cloud.volume[0], 1.0);
 }
+
+/// `SceneSites` numbers and places every particle as `build` does, region by region.
+#[test]
+fn scene_sites_match_build_site_for_site() {
+    let ops = vec![
+        add(bx([0.0; 3], [12.0, 6.0, 5.0]), 0),
+        Op::Subtract {
+            shape: cyl([6.0, 3.0, -1.0], [0.0, 0.0, 1.0], 7.0, 1.6),
+        },
+        add(cube(2.0, 4.0), 3),
+        Op::Subtract {
+            shape: Shape::Slab {
+                axis: 0,
+                from: 9.0,
+                to: 10.0,
+            },
+        },
+    ];
+    let bars = [x_bar([0.0, 1.5, 1.5], 12.0, 0.2, 0.7)];
+    for kind in [LatticeKind::Sc, LatticeKind::Fcc, LatticeKind::Bcc] {
+        let lattice = Lattice {
+            jitter: 0.1,
+            seed: 7,
+            ..cubic(kind, 1.0)
+        };
+        let cloud = build(&lattice, &ops, &bars).unwrap();
+        let sites = SceneSites::new(&lattice, &ops, &bars).unwrap();
+        assert_eq!(sites.len(), cloud.len(), "{kind:?}");
+        // Two halves along x, as two procCubes would take them, make the whole.
+        let mut all = sites.select(|_, _| true, |p| p[0] < 6.0);
+        all.extend(sites.select(|_, _| true, |p| p[0] >= 6.0));
+        all.sort_by_key(|s| s.gid);
+        for (g, s) in all.iter().enumerate() {
+            assert_eq!(s.gid as usize, g);
+            assert_eq!(s.position, cloud.position[g], "{kind:?} particle {g}");
+            assert_eq!(
+                (s.volume, s.material, s.bar),
+                (cloud.volume[g], cloud.material[g], cloud.bar[g])
+            );
+        }
+        assert_eq!(all.len(), cloud.len());
+    }
+}

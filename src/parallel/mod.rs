@@ -3,6 +3,7 @@
 //! MPI ranks), team reductions and gathers in rank order, particle shuffling ([`shuffle`]) and
 //! the procCube itself ([`cube`]), which steps with its wall exchange.
 
+pub mod balance;
 pub mod comm;
 #[cfg(feature = "mpi")]
 pub mod comm_mpi;
@@ -10,6 +11,7 @@ pub mod cube;
 pub mod decomposition;
 pub mod deform;
 mod migrate;
+pub mod part;
 pub mod shuffle;
 pub mod snapshot;
 pub mod wall;

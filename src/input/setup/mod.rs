@@ -16,9 +16,9 @@ use std::time::Instant;
 mod maxwell;
 pub mod memory;
 mod pairs;
-mod place;
+pub(crate) mod place;
 mod thermostat;
-mod time_step;
+pub(crate) mod time_step;
 
 /// A simulation built from a deck, with what the deck's checks found.
 pub struct Setup<M: Model> {
@@ -91,10 +91,12 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
             "no particle has a bond: the horizon is too small for the particle spacing",
         ));
     }
-    place::initial_state(&mut particles, scene, &gid_to_index)?;
-    place::thermal_velocities(&mut particles, scene, &gid_to_index)?;
-    let constraints = place::constraints(&particles, scene, &gid_to_index)?;
-    let loads = place::loads(&particles, scene, &gid_to_index)?;
+    let index = |g: u32| gid_to_index.get(g as usize).copied();
+    let scope = place::Scope::whole(&index, gid_to_index.len());
+    place::initial_state(&mut particles, scene, &scope)?;
+    place::thermal_velocities(&mut particles, scene, &scope)?;
+    let constraints = place::constraints(&particles, scene, &scope)?;
+    let loads = place::loads(&particles, scene, &scope)?;
     let probes = place::probes(&particles, scene);
 
     let mut sim = Simulation::new(
@@ -109,7 +111,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     let stepping = time_step::stepping(&mut sim, scene, dt_critical, dt_critical_particle)?;
     let dt = stepping.dt;
     sim.dt = dt;
-    sim.thermostat = thermostat::thermostat(&sim, scene, &gid_to_index)?;
+    sim.thermostat = thermostat::thermostat(&sim, scene, &scope)?;
     for c in &sim.constraints {
         c.set_velocity(&mut sim.particles, 0.0, dt);
     }
@@ -310,21 +312,35 @@ fn bar_bonds<M: Model>(
 /// on the cell faces: from the lowest cell face to the highest cell's far face, so n cells are
 /// exactly n·a long).
 fn domain(points: &[[f64; 3]], scene: &Scene, reach: f64) -> Result<Domain, DeckError> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    domain_of_box(lo, hi, points.len(), scene, reach)
+}
+
+/// [`domain`] of `points` particles whose positions span the box `[lo, hi]`.
+pub fn domain_of_box(
+    lo: [f64; 3],
+    hi: [f64; 3],
+    points: usize,
+    scene: &Scene,
+    reach: f64,
+) -> Result<Domain, DeckError> {
     // With shuffling, bonds are found from current cells: the skin keeps a stretched bond
     // between neighbouring cells.
     let min_cell = (cell_reach(scene) * (1.0 + scene.parallel.skin)).max(reach);
-    let mut grid = CellGrid::covering(points, min_cell);
+    let mut grid = CellGrid::covering_box(lo, hi, points, min_cell);
     let mut period = [0.0; 3];
     for a in 0..3 {
         if !scene.periodic[a] {
             continue;
         }
-        let lo = points.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min);
-        let hi = points
-            .iter()
-            .map(|p| p[a])
-            .fold(f64::NEG_INFINITY, f64::max);
-        let (start, length) = periodic_span(&scene.lattice, a, lo, hi);
+        let (start, length) = periodic_span(&scene.lattice, a, lo[a], hi[a]);
         let n = (length / (min_cell * (1.0 + 1e-9))).floor() as usize;
         if n < 3 {
             return Err(scene.error(
@@ -378,12 +394,16 @@ fn cell_reach(scene: &Scene) -> f64 {
 /// Builds model `M` from the deck's materials and horizon (the deck's model name is not
 /// consulted): for tests and tools that know their model at compile time.
 pub fn build_as<M: Model>(scene: &Scene) -> Result<Setup<M>, DeckError> {
+    build(model_as(scene)?, scene)
+}
+
+/// Model `M` with the deck's materials and horizon (see [`build_as`]).
+pub fn model_as<M: Model>(scene: &Scene) -> Result<M, DeckError> {
     let b = ModelBuild {
         materials: &scene.materials,
         horizon: scene.horizon,
         spacing: scene.spacing,
         options: &scene.model_options,
     };
-    let model = M::build(&b).map_err(|e| scene.model_error(&e))?;
-    build(model, scene)
+    M::build(&b).map_err(|e| scene.model_error(&e))
 }

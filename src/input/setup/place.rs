@@ -8,11 +8,33 @@ use crate::input::deck::{DeckError, LoadKind, Region, Scene};
 use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model};
 
-/// Store indices of the particles of a region, in store order.
-pub(super) fn select<M: Model>(
+/// Which particles the deck's regions see: the whole scene, or the owned particles of one
+/// procCube (per-rank setup), with counts and sums taken over the whole scene by `sum`.
+pub struct Scope<'a> {
+    /// The local index of a global id held here, `None` when it is elsewhere.
+    pub index: &'a dyn Fn(u32) -> Option<u32>,
+    /// Particles in the whole scene (ids run below it).
+    pub total: usize,
+    /// The sum over every procCube of a value each holds (the identity for the whole scene).
+    pub sum: &'a dyn Fn(f64) -> f64,
+}
+
+impl<'a> Scope<'a> {
+    /// The whole scene, `index` giving the store index of each global id.
+    pub fn whole(index: &'a dyn Fn(u32) -> Option<u32>, total: usize) -> Scope<'a> {
+        Scope {
+            index,
+            total,
+            sum: &|x| x,
+        }
+    }
+}
+
+/// Store indices of the (owned) particles of a region, in store order.
+pub(crate) fn select<M: Model>(
     p: &Particles<M>,
     region: &Region,
-    gid_to_index: &[u32],
+    scope: &Scope,
 ) -> Result<Vec<u32>, String> {
     let n = p.n_owned;
     Ok(match region {
@@ -24,15 +46,13 @@ pub(super) fn select<M: Model>(
         Region::Ids(ids) => {
             let mut v = Vec::with_capacity(ids.len());
             for &id in ids {
-                match gid_to_index.get(id as usize) {
-                    Some(&i) => v.push(i),
-                    None => {
-                        return Err(format!(
-                            "particle id {id} does not exist (ids run from 0 to {})",
-                            gid_to_index.len() - 1
-                        ))
-                    }
+                if id as usize >= scope.total {
+                    return Err(format!(
+                        "particle id {id} does not exist (ids run from 0 to {})",
+                        scope.total - 1
+                    ));
                 }
+                v.extend((scope.index)(id).filter(|&i| (i as usize) < n));
             }
             v.sort_unstable();
             v.dedup();
@@ -41,17 +61,22 @@ pub(super) fn select<M: Model>(
     })
 }
 
+/// Whether a selection is empty on every procCube.
+fn none_selected(sel: &[u32], scope: &Scope) -> bool {
+    (scope.sum)(sel.len() as f64) == 0.0
+}
+
 /// Sets the deck's initial velocities, angular velocities and temperatures.
-pub(super) fn initial_state<M: Model>(
+pub(crate) fn initial_state<M: Model>(
     particles: &mut Particles<M>,
     scene: &Scene,
-    gid_to_index: &[u32],
+    scope: &Scope,
 ) -> Result<(), DeckError> {
     let n2 = second_order::<M>();
     for init in &scene.initial {
         let at = |what: &str| scene.error(Some(init.line), format!("initial: {what}"));
-        let sel = select(particles, &init.region, gid_to_index).map_err(|e| at(&e))?;
-        if sel.is_empty() {
+        let sel = select(particles, &init.region, scope).map_err(|e| at(&e))?;
+        if none_selected(&sel, scope) {
             return Err(at("the region selects no particle"));
         }
         if init.angular_velocity.is_some() && n2 < 6 {
@@ -86,13 +111,13 @@ pub(super) fn initial_state<M: Model>(
 pub(super) fn thermal_velocities<M: Model>(
     particles: &mut Particles<M>,
     scene: &Scene,
-    gid_to_index: &[u32],
+    scope: &Scope,
 ) -> Result<(), DeckError> {
     let Some(spec) = &scene.velocity else {
         return Ok(());
     };
     let at = |what: &str| scene.error(Some(spec.line), format!("[velocity]: {what}"));
-    let sel = select(particles, &spec.region, gid_to_index).map_err(|e| at(&e))?;
+    let sel = select(particles, &spec.region, scope).map_err(|e| at(&e))?;
     let gid: Vec<u32> = sel.iter().map(|&i| particles.gid[i as usize]).collect();
     let mass: Vec<[f64; 3]> = sel
         .iter()
@@ -112,16 +137,16 @@ pub(super) fn thermal_velocities<M: Model>(
 }
 
 /// The deck's boundary conditions on the particles and degrees of freedom they hold.
-pub(super) fn constraints<M: Model>(
+pub(crate) fn constraints<M: Model>(
     particles: &Particles<M>,
     scene: &Scene,
-    gid_to_index: &[u32],
+    scope: &Scope,
 ) -> Result<Vec<Constraint>, DeckError> {
     let mut constraints = Vec::new();
     for b in &scene.boundaries {
         let at = |e: String| scene.error(Some(b.line), format!("boundary '{}': {e}", b.name));
-        let sel = select(particles, &b.region, gid_to_index).map_err(at)?;
-        if sel.is_empty() {
+        let sel = select(particles, &b.region, scope).map_err(at)?;
+        if none_selected(&sel, scope) {
             return Err(at("the region selects no particle".into()));
         }
         let mut dofs = Vec::with_capacity(b.dofs.len());
@@ -140,17 +165,17 @@ pub(super) fn constraints<M: Model>(
 }
 
 /// The deck's loads, each spread over its particles by its kind's weights.
-pub(super) fn loads<M: Model>(
+pub(crate) fn loads<M: Model>(
     particles: &Particles<M>,
     scene: &Scene,
-    gid_to_index: &[u32],
+    scope: &Scope,
 ) -> Result<Vec<Load>, DeckError> {
     let n2 = second_order::<M>();
     let mut loads = Vec::new();
     for l in &scene.loads {
         let at = |e: String| scene.error(Some(l.line), format!("load '{}': {e}", l.name));
-        let sel = select(particles, &l.region, gid_to_index).map_err(at)?;
-        if sel.is_empty() {
+        let sel = select(particles, &l.region, scope).map_err(at)?;
+        if none_selected(&sel, scope) {
             return Err(at("the region selects no particle".into()));
         }
         if l.kind.is_heat() && M::FIRST_ORDER == 0 {
@@ -159,7 +184,7 @@ pub(super) fn loads<M: Model>(
                 M::NAME
             )));
         }
-        let (vector, weight) = load_weights(particles, l.kind, &sel, scene.spacing);
+        let (vector, weight) = load_weights(particles, l.kind, &sel, scene.spacing, scope);
         loads.push(Load {
             name: l.name.clone(),
             particles: sel,
@@ -178,12 +203,13 @@ fn load_weights<M: Model>(
     kind: LoadKind,
     sel: &[u32],
     spacing: f64,
+    scope: &Scope,
 ) -> ([f64; 3], Vec<f64>) {
     let volume_of = |i: &u32| particles.volume[*i as usize];
     match kind {
         LoadKind::PerParticle(v) => (v, vec![1.0; sel.len()]),
         LoadKind::Total(v) => {
-            let total: f64 = sel.iter().map(volume_of).sum();
+            let total: f64 = (scope.sum)(sel.iter().map(volume_of).sum());
             (v, sel.iter().map(|i| volume_of(i) / total).collect())
         }
         LoadKind::BodyForce(v) => (v, sel.iter().map(volume_of).collect()),
@@ -199,7 +225,7 @@ fn load_weights<M: Model>(
         ),
         LoadKind::HeatSource(q) => ([q, 0.0, 0.0], sel.iter().map(volume_of).collect()),
         LoadKind::TotalHeat(q) => {
-            let total: f64 = sel.iter().map(volume_of).sum();
+            let total: f64 = (scope.sum)(sel.iter().map(volume_of).sum());
             (
                 [q, 0.0, 0.0],
                 sel.iter().map(|i| volume_of(i) / total).collect(),
@@ -209,19 +235,29 @@ fn load_weights<M: Model>(
 }
 
 /// Each probe's name and the particle nearest to its point.
-pub(super) fn probes<M: Model>(particles: &Particles<M>, scene: &Scene) -> Vec<(String, usize)> {
+pub(crate) fn probes<M: Model>(particles: &Particles<M>, scene: &Scene) -> Vec<(String, usize)> {
     scene
         .probes
         .iter()
         .map(|pr| {
-            let nearest = (0..particles.n_owned)
-                .min_by(|&a, &b| {
-                    dist2(particles.x0[a], pr.at).total_cmp(&dist2(particles.x0[b], pr.at))
-                })
-                .unwrap_or(0);
-            (pr.name.clone(), nearest)
+            (
+                pr.name.clone(),
+                nearest(particles, pr.at).map_or(0, |(_, i)| i),
+            )
         })
         .collect()
+}
+
+/// The owned particle nearest to `at` (ties to the smaller global id, so that any layout picks
+/// the same one) and its squared distance.
+pub(crate) fn nearest<M: Model>(particles: &Particles<M>, at: [f64; 3]) -> Option<(f64, usize)> {
+    let key = |i: usize| (dist2(particles.x0[i], at), particles.gid[i]);
+    (0..particles.n_owned)
+        .min_by(|&a, &b| {
+            let (ka, kb) = (key(a), key(b));
+            ka.0.total_cmp(&kb.0).then(ka.1.cmp(&kb.1))
+        })
+        .map(|i| (key(i).0, i))
 }
 
 /// The model's index of a DOF the deck names (x, y, z, rotations, temperature).

@@ -11,14 +11,14 @@ use crate::model::Model;
 pub(super) fn thermostat<M: Model>(
     sim: &Simulation<M>,
     scene: &Scene,
-    gid_to_index: &[u32],
+    scope: &super::place::Scope,
 ) -> Result<Option<Thermostat>, DeckError> {
     let Some(spec) = &scene.thermostat else {
         return Ok(None);
     };
     let at = |what: String| scene.error(Some(spec.line), format!("[thermostat] {what}"));
     let p = &sim.particles;
-    let mut group = select(p, &spec.region, gid_to_index).map_err(&at)?;
+    let mut group = select(p, &spec.region, scope).map_err(&at)?;
     if !spec.materials.is_empty() {
         group.retain(|&i| spec.materials.contains(&p.material[i as usize]));
     }

@@ -54,6 +54,22 @@ pub(super) fn stepping<M: Model>(
             ),
         ),
     };
+    let (dt, steps) = below_limit(scene, limit, &limit_name)?;
+    Ok(Stepping {
+        dt,
+        steps,
+        dt_measured,
+    })
+}
+
+/// Δt below the stable step `limit` (named for the message), or the deck's own if it is below,
+/// and the steps of the run.
+pub(crate) fn below_limit(
+    scene: &Scene,
+    limit: f64,
+    limit_name: &str,
+) -> Result<(f64, u64), DeckError> {
+    let time_line = Some(scene.time.line);
     let dt = match scene.time.dt {
         Some(dt) => {
             if dt > limit && !scene.time.force_dt {
@@ -75,11 +91,7 @@ pub(super) fn stepping<M: Model>(
             format!("[time] the run would take {steps} steps of {dt:.4e}: shorten the duration"),
         ));
     }
-    Ok(Stepping {
-        dt,
-        steps,
-        dt_measured,
-    })
+    Ok((dt, steps))
 }
 
 /// The steps at time step `dt`. A static start reaches `static_until` without steps; the steps
