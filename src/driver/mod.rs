@@ -10,5 +10,6 @@ mod observers;
 pub mod post;
 mod record;
 pub mod run;
+pub mod run_part;
 mod step_loop;
 mod thermo;

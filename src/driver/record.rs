@@ -15,6 +15,17 @@ use std::fmt::Write as _;
 
 /// The names of the history columns, in the order of [`Row::values`].
 pub(crate) fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
+    let probes: Vec<&str> = setup.probes.iter().map(|(n, _)| n.as_str()).collect();
+    columns_of(&setup.sim, &probes, &setup.solver)
+}
+
+/// [`columns`] of a simulation (the whole scene's or one procCube's: every procCube has every
+/// boundary condition and load), its probes' names and its solver.
+pub(crate) fn columns_of<M: Model>(
+    sim: &crate::engine::simulation::Simulation<M>,
+    probes: &[&str],
+    solver: &SolverSpec,
+) -> Vec<String> {
     let mut c: Vec<String> = [
         "step",
         "time",
@@ -27,7 +38,7 @@ pub(crate) fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
     .iter()
     .map(|s| s.to_string())
     .collect();
-    if setup.sim.pairs.is_some() {
+    if sim.pairs.is_some() {
         // total_energy then includes the pairs' energy.
         for k in [
             "pair_energy",
@@ -40,29 +51,29 @@ pub(crate) fn columns<M: Model>(setup: &Setup<M>) -> Vec<String> {
             c.push(k.into());
         }
     }
-    if setup.sim.thermostat.is_some() {
+    if sim.thermostat.is_some() {
         c.push("conserved_energy".into());
     }
-    for l in &setup.sim.loads {
+    for l in &sim.loads {
         c.push(format!("load_{}", l.name));
     }
-    for b in &setup.sim.constraints {
+    for b in &sim.constraints {
         for &d in &b.dofs {
             c.push(format!("reaction_{}_{}", b.name, dof_name::<M>(d)));
         }
     }
-    for b in &setup.sim.constraints {
+    for b in &sim.constraints {
         for d in b.dofs.iter().filter(|&&d| d < 3) {
             c.push(format!("displacement_{}_{}", b.name, dof_name::<M>(*d)));
         }
     }
-    for (name, _) in &setup.probes {
+    for name in probes {
         for k in ["ux", "uy", "uz"] {
             c.push(format!("{name}_{k}"));
         }
     }
     c.push("residual_force".into());
-    if let SolverSpec::Relaxation { .. } = setup.solver {
+    if let SolverSpec::Relaxation { .. } = solver {
         c.push("iterations".into());
         c.push("residual".into());
     }

@@ -87,11 +87,37 @@ pub fn run(scene: &Scene, opts: &RunOptions) -> Result<Summary, String> {
     impl ModelVisitor for Visit<'_> {
         type Output = Result<Summary, String>;
         fn visit<M: Model>(self, model: M) -> Self::Output {
+            #[cfg(feature = "mpi")]
+            if crate::parallel::comm_mpi::launched_by_mpirun()
+                && super::run_part::per_rank(self.0, self.1)
+            {
+                return on_ranks_per_rank(model, self.0, self.1);
+            }
             let setup = setup::build(model, self.0).map_err(|e| e.to_string())?;
             run_setup(setup, self.0, self.1)
         }
     }
     setup::with_model(scene, Visit(scene, opts)).map_err(|e| e.to_string())?
+}
+
+/// One procCube per rank under `mpirun`, each built on its own (`run_part`).
+#[cfg(feature = "mpi")]
+fn on_ranks_per_rank<M: Model>(
+    model: M,
+    scene: &Scene,
+    opts: &RunOptions,
+) -> Result<Summary, String> {
+    let mpi = crate::parallel::comm_mpi::Mpi::init().ok_or("MPI was already initialized")?;
+    let (rank, ranks) = (mpi.rank(), mpi.size());
+    let quiet = RunOptions {
+        quiet: opts.quiet || rank != 0,
+        ..opts.clone()
+    };
+    match super::run_part::run_rank(model, scene, &quiet, rank, ranks, Box::new(mpi))? {
+        Some(s) => Ok(s),
+        // Other ranks have nothing to print; a summary-less Ok ends them quietly.
+        None => std::process::exit(0),
+    }
 }
 
 /// The layout, and how many workers: MPI ranks when launched by `mpirun`, threads otherwise.
@@ -279,58 +305,25 @@ impl<M: Model> Prepared<'_, M> {
 
     /// What the step loop needs to know about the run on `layout`.
     fn plan(&self, layout: &Layout) -> Plan {
-        let (setup, scene, out) = (&self.setup, self.scene, &self.scene.output);
-        Plan {
+        let setup = &self.setup;
+        let facts = RunFacts {
             columns: columns(setup),
-            dir: self.dir.clone(),
             steps: setup.steps,
-            every: out.history_every,
-            frames_every: out.frames_every,
-            progress: out.progress,
-            quiet: self.opts.quiet,
-            final_state: out.final_state,
-            shuffle_every: scene.parallel.shuffle_every,
-            stop_at_broken: scene.time.stop_at_broken_bonds,
-            probe_stops: scene
-                .probes
-                .iter()
-                .map(|p| (p.name.clone(), p.stop_beyond))
-                .collect(),
-            layout: layout.describe(),
-            first_step: self.start_state().map_or(0, |c| c.step),
-            static_evaluations: self.static_start.as_ref().map_or(0, |s| s.evaluations),
-            solver: self.solver.clone(),
             dt_critical: setup.dt_limit(),
-            dt_critical_name: if setup.dt_measured.is_some() {
-                "measured critical step"
-            } else {
-                "stable bound"
-            },
-            material_names: scene.materials.iter().map(|m| m.name.clone()).collect(),
-            spacing: scene.spacing,
-            checkpoints: CheckpointPlan {
-                dir: self.dir.join("checkpoints"),
-                every: out.checkpoint_every,
-                minutes: out.checkpoint_minutes,
-                keep: out.checkpoint_keep,
-                scene_hash: self.scene_hash,
-                deck: scene.file.clone(),
-            },
+            measured: setup.dt_measured.is_some(),
+            horizon: setup.horizon,
             thermo: setup
                 .sim
                 .pairs
                 .is_some()
-                .then(|| Thermo::of_setup(setup, scene.units.boltzmann())),
-            picture: out.picture.map(|c| match c {
-                // Bondless particles (no horizon) have no damage to show.
-                Colouring::Auto if setup.horizon <= 0.0 => Colouring::Speed,
-                Colouring::Auto => Colouring::Damage,
-                c => c,
-            }),
-            title: scene.title.clone(),
-            analyses: analysis_plans(setup, scene),
-            deform: scene.deform.clone(),
-        }
+                .then(|| Thermo::of_setup(setup, self.scene.units.boltzmann())),
+            analyses: analysis_plans(setup, self.scene),
+            first_step: self.start_state().map_or(0, |c| c.step),
+            static_evaluations: self.static_start.as_ref().map_or(0, |s| s.evaluations),
+            solver: self.solver.clone(),
+            scene_hash: self.scene_hash,
+        };
+        run_plan(facts, self.scene, self.opts, &self.dir, layout)
     }
 
     /// One procCube per rank under `mpirun`; the root gathers the frames and the summary.
@@ -483,7 +476,7 @@ fn prepare<M: Model>(
     Ok(())
 }
 
-fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
+pub(super) fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
     if let Some(c) = &summary.interrupted {
         // Said even with --quiet: the run did not finish.
         eprintln!(
@@ -534,6 +527,12 @@ fn analysis_plans<M: Model>(setup: &Setup<M>, scene: &Scene) -> Vec<AnalysisPlan
         .iter()
         .position(|&g| g == 0)
         .map_or([0.0; 3], |i| p.x0[i]);
+    analysis_plans_at(anchor, scene)
+}
+
+/// The deck's analyses, their voxels anchored at `anchor` (the reference position of the
+/// particle with global id 0).
+pub(super) fn analysis_plans_at(anchor: [f64; 3], scene: &Scene) -> Vec<AnalysisPlan> {
     scene
         .analyses
         .iter()
@@ -555,4 +554,78 @@ fn analysis_plans<M: Model>(setup: &Setup<M>, scene: &Scene) -> Vec<AnalysisPlan
             anchor,
         })
         .collect()
+}
+
+/// What a run's plan takes from its built scene (the whole scene's setup, or a per-rank one).
+pub(super) struct RunFacts {
+    pub columns: Vec<String>,
+    pub steps: u64,
+    /// The critical step Δt was chosen against, and whether it was measured.
+    pub dt_critical: f64,
+    pub measured: bool,
+    pub horizon: f64,
+    pub thermo: Option<Thermo>,
+    pub analyses: Vec<AnalysisPlan>,
+    pub first_step: u64,
+    pub static_evaluations: u64,
+    pub solver: SolverChoice,
+    pub scene_hash: u64,
+}
+
+/// What the step loop needs to know about the run on `layout`.
+pub(super) fn run_plan(
+    facts: RunFacts,
+    scene: &Scene,
+    opts: &RunOptions,
+    dir: &std::path::Path,
+    layout: &Layout,
+) -> Plan {
+    let out = &scene.output;
+    Plan {
+        columns: facts.columns,
+        dir: dir.to_path_buf(),
+        steps: facts.steps,
+        every: out.history_every,
+        frames_every: out.frames_every,
+        progress: out.progress,
+        quiet: opts.quiet,
+        final_state: out.final_state,
+        shuffle_every: scene.parallel.shuffle_every,
+        stop_at_broken: scene.time.stop_at_broken_bonds,
+        probe_stops: scene
+            .probes
+            .iter()
+            .map(|p| (p.name.clone(), p.stop_beyond))
+            .collect(),
+        layout: layout.describe(),
+        first_step: facts.first_step,
+        static_evaluations: facts.static_evaluations,
+        solver: facts.solver,
+        dt_critical: facts.dt_critical,
+        dt_critical_name: if facts.measured {
+            "measured critical step"
+        } else {
+            "stable bound"
+        },
+        material_names: scene.materials.iter().map(|m| m.name.clone()).collect(),
+        spacing: scene.spacing,
+        checkpoints: CheckpointPlan {
+            dir: dir.join("checkpoints"),
+            every: out.checkpoint_every,
+            minutes: out.checkpoint_minutes,
+            keep: out.checkpoint_keep,
+            scene_hash: facts.scene_hash,
+            deck: scene.file.clone(),
+        },
+        thermo: facts.thermo,
+        picture: out.picture.map(|c| match c {
+            // Bondless particles (no horizon) have no damage to show.
+            Colouring::Auto if facts.horizon <= 0.0 => Colouring::Speed,
+            Colouring::Auto => Colouring::Damage,
+            c => c,
+        }),
+        title: scene.title.clone(),
+        analyses: facts.analyses,
+        deform: scene.deform.clone(),
+    }
 }

@@ -257,17 +257,41 @@ impl SceneSites {
 
     /// Every particle's position, in id order, to `visit` (the census of cells).
     pub fn for_each_position(&self, mut visit: impl FnMut(&Vec3)) {
+        self.for_each(|s| visit(&s.position));
+    }
+
+    /// Every particle, in id order, to `visit`.
+    pub fn for_each(&self, mut visit: impl FnMut(Site)) {
         let (i0, i1) = self.range[0];
+        let volume = self.lattice.site_volume();
+        let mut gid = 0u32;
         for (k, j) in self.rows() {
             for i in i0..=i1 {
                 let key = [k, j, i];
-                if self.material(&key).is_some() {
-                    visit(&self.position(&key));
+                if let Some(material) = self.material(&key) {
+                    let position = self.position(&key);
+                    let bar = NOT_A_BAR;
+                    visit(Site {
+                        gid,
+                        position,
+                        volume,
+                        material,
+                        bar,
+                    });
+                    gid += 1;
                 }
             }
         }
-        for (b, _) in &self.bar_particles {
-            visit(&b.position);
+        for (b, bar) in &self.bar_particles {
+            let (position, volume, material, bar) = (b.position, b.volume, b.material, *bar);
+            visit(Site {
+                gid,
+                position,
+                volume,
+                material,
+                bar,
+            });
+            gid += 1;
         }
     }
 

@@ -300,13 +300,49 @@ fn parse_parts(text: &str, example: Option<&str>) -> Result<(f64, f64, Dim), Str
     Ok((num, factor, dim))
 }
 
-/// Split the longest prefix that is an f64 literal off `s` ("3in" works too).
+/// Split the longest prefix that is an f64 literal off `s` ("3in" works too). Only prefixes
+/// of the literal's shape ([`literal_end`]) are tried: trying every prefix of the whole text
+/// took time quadratic in its length (a 60 kB value, 1 s; found by tests/deck_fuzz.rs).
 fn split_number(s: &str) -> Option<(f64, &str)> {
-    let end = (1..=s.len())
+    let end = (1..=literal_end(s))
         .rev()
-        .find(|&i| s.is_char_boundary(i) && s[..i].parse::<f64>().is_ok())?;
+        .find(|&i| s[..i].parse::<f64>().is_ok())?;
     let v: f64 = s[..end].parse().ok()?;
     v.is_finite().then_some((v, &s[end..]))
+}
+
+/// The end of the longest prefix of `s` shaped like an f64 literal (ASCII, so every byte up
+/// to it is a char boundary): a sign, then `inf`, `infinity` or `nan` in any case, or digits
+/// with at most one point and an exponent with digits. No longer prefix parses as an f64.
+fn literal_end(s: &str) -> usize {
+    let b = s.as_bytes();
+    let digits = |mut j: usize| {
+        while b.get(j).is_some_and(u8::is_ascii_digit) {
+            j += 1;
+        }
+        j
+    };
+    let mut i = usize::from(matches!(b.first(), Some(b'+' | b'-')));
+    for word in ["infinity", "inf", "nan"] {
+        let end = i + word.len();
+        if b.get(i..end)
+            .is_some_and(|w| w.eq_ignore_ascii_case(word.as_bytes()))
+        {
+            return end;
+        }
+    }
+    i = digits(i);
+    if b.get(i) == Some(&b'.') {
+        i = digits(i + 1);
+    }
+    if matches!(b.get(i), Some(b'e' | b'E')) {
+        let sign = usize::from(matches!(b.get(i + 1), Some(b'+' | b'-')));
+        let end = digits(i + 1 + sign);
+        if end > i + 1 + sign {
+            i = end;
+        }
+    }
+    i
 }
 
 /// Unit grammar: factor (("*" | "·" | "/") factor)*, factor = name ("^" | "**") int;

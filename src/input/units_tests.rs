@@ -172,3 +172,31 @@ fn toml_vector() {
     let err = position("\"1 2 3 s\"").unwrap_err();
     assert!(err.contains("length") && err.contains("time"), "{err}");
 }
+
+#[test]
+fn numbers_are_split_off_their_units_in_linear_time() {
+    for (text, number, rest) in [
+        ("3in", 3.0, "in"),
+        ("3 in", 3.0, " in"),
+        ("-1.5e3mm", -1500.0, "mm"),
+        ("+.5E+1 s", 5.0, " s"),
+        ("1. m", 1.0, " m"),
+        ("2e m", 2.0, "e m"),
+        ("7e+x", 7.0, "e+x"),
+    ] {
+        assert_eq!(split_number(text), Some((number, rest)), "{text}");
+    }
+    for text in ["inf m", "-Infinity", "NaN mm", ".", "e5 m", "mm", "", "-"] {
+        assert_eq!(split_number(text), None, "{text}");
+    }
+    // A long number followed by a long run of letters: every prefix of the whole text used
+    // to be parsed (seconds at this length).
+    let long = format!("{}{}", "1".repeat(200_000), "m".repeat(200_000));
+    let start = std::time::Instant::now();
+    assert!(parse_quantity(&long).is_err());
+    assert!(
+        start.elapsed().as_secs_f64() < 1.0,
+        "took {:?}",
+        start.elapsed()
+    );
+}

@@ -61,20 +61,36 @@ pub fn scene_hash<M: Model>(setup: &Setup<M>, scene: &crate::input::deck::Scene)
     let p = &setup.sim.particles;
     let mut order: Vec<usize> = (0..p.len()).collect();
     order.sort_unstable_by_key(|&i| p.gid[i]);
+    scene_hash_of::<M>(scene, &setup.bars.bar_of, p.len(), |each| {
+        for i in order {
+            each(&p.x0[i], p.volume[i], p.material[i]);
+        }
+    })
+}
+
+/// [`scene_hash`] of a scene of `n` particles whose reference positions, volumes and materials
+/// `particles` hands out in global id order (each procCube of a per-rank setup streams them from
+/// the geometry), with `bar_of` each particle's bar by global id (empty without bars).
+pub fn scene_hash_of<M: Model>(
+    scene: &crate::input::deck::Scene,
+    bar_of: &[u32],
+    n: usize,
+    particles: impl FnOnce(&mut dyn FnMut(&[f64; 3], f64, u16)),
+) -> u64 {
     let mut h = Fnv::new();
     h.bytes(M::NAME.as_bytes());
     h.bytes(schema::<M>().as_bytes());
     h.bytes(format!("{:?}{:?}", scene.materials, scene.model_options).as_bytes());
     // Bars: which particle belongs to which (their own bonds are calibrated) and their
     // prestrain, which a restart must not change under bonds that already carry it.
-    h.bytes(format!("{:?}{:?}", setup.bars.bar_of, scene.bar_prestrain()).as_bytes());
-    h.f64s(&[setup.horizon, setup.spacing]);
-    h.bytes(&(p.len() as u64).to_le_bytes());
-    for i in order {
-        h.f64s(&p.x0[i]);
-        h.f64s(&[p.volume[i]]);
-        h.bytes(&p.material[i].to_le_bytes());
-    }
+    h.bytes(format!("{:?}{:?}", bar_of, scene.bar_prestrain()).as_bytes());
+    h.f64s(&[scene.horizon, scene.spacing]);
+    h.bytes(&(n as u64).to_le_bytes());
+    particles(&mut |x0, volume, material| {
+        h.f64s(x0);
+        h.f64s(&[volume]);
+        h.bytes(&material.to_le_bytes());
+    });
     h.0
 }
 

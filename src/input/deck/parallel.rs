@@ -7,6 +7,11 @@ use super::spec::ParallelSpec;
 use crate::input::procs::{Procs, Walls};
 use toml::Spanned;
 
+/// The most workers (threads, procCubes) a deck may ask for: far beyond any machine, and low
+/// enough that the layout search over nx·ny·nz = workers stays quick (`threads = 10¹¹` kept
+/// `pdq check` searching for hours) and counts multiply without overflow.
+const MAX_WORKERS: i64 = 1 << 20;
+
 impl Converter {
     pub(super) fn parallel(&self, section: Option<&Spanned<ParallelSection>>) -> R<ParallelSpec> {
         let (p, line) = match section {
@@ -29,12 +34,25 @@ impl Converter {
                         format!("[parallel] procs = {v:?}: every count must be at least 1"),
                     );
                 }
+                let cubes = v.iter().try_fold(1i64, |p, &n| p.checked_mul(n));
+                if cubes.is_none_or(|c| c > MAX_WORKERS) {
+                    return self.err(
+                        line,
+                        format!("[parallel] procs = {v:?} makes more than {MAX_WORKERS} procCubes; give at most {MAX_WORKERS} (one per worker)"),
+                    );
+                }
                 Procs::Given(v.map(|n| n as usize))
             }
         };
         let threads = match (p.threads, &procs) {
             (Some(t), _) if t < 1 => {
                 return self.err(line, format!("[parallel] threads = {t}: must be at least 1"))
+            }
+            (Some(t), _) if t > MAX_WORKERS => {
+                return self.err(
+                    line,
+                    format!("[parallel] threads = {t}: give at most {MAX_WORKERS} (one procCube per thread)"),
+                )
             }
             (Some(t), Procs::Given(v)) if t as usize != v.iter().product::<usize>() => {
                 return self.err(

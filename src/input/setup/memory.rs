@@ -43,11 +43,11 @@ pub fn estimate<M: Model>(scene: &Scene, reach: f64) -> Option<Estimate> {
         &scene.geometry_bars(),
     )?;
     let per_bond = if M::BONDED {
-        geometry::neighbours_within(lattice, scene.horizon) as f64
+        neighbours(lattice, scene.horizon)
     } else {
         0.0
     };
-    let per_pair = geometry::neighbours_within(lattice, reach) as f64;
+    let per_pair = neighbours(lattice, reach);
     let (bonds, pairs) = (0.5 * particles * per_bond, 0.5 * particles * per_pair);
     let records = particles * Particles::<M>::bytes_per_particle() as f64
         + bonds * BondList::<M::Bond>::bytes_per_bond() as f64
@@ -59,6 +59,20 @@ pub fn estimate<M: Model>(scene: &Scene, reach: f64) -> Option<Estimate> {
         records,
         peak: PEAK_OVER_RECORDS * records,
     })
+}
+
+/// Beyond this many spacings the sites within a radius are not counted one by one (that
+/// takes (2·radius/step)³ tests: `pdq check` of a horizon of 10⁶ spacings never ended) but
+/// taken from the ball's volume, within 0.2 % of the count there on sc, fcc and bcc.
+const COUNTED_RADIUS: f64 = 40.0;
+
+/// Lattice sites within `radius` of an interior site (bonds or pairs of one particle).
+fn neighbours(lattice: &geometry::Lattice, radius: f64) -> f64 {
+    if !(radius > COUNTED_RADIUS * lattice.spacing) {
+        return geometry::neighbours_within(lattice, radius) as f64;
+    }
+    let ball = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
+    ball / lattice.site_volume()
 }
 
 /// Bytes this process may still allocate, and where the figure comes from: the smaller of the
