@@ -101,8 +101,11 @@ fn same_cube(a: &Cube<Pmb>, b: &Cube<Pmb>, what: &str) {
     assert_eq!(a.sim.dt, b.sim.dt, "{what}: time step");
 }
 
+/// Broken bonds and final positions, by global id.
+type Outcome = (Vec<(u32, u32)>, Vec<(u32, [f64; 3])>);
+
 /// Steps a set of procCubes on threads; the broken bonds and final positions by global id.
-fn step(cubes: Vec<Cube<Pmb>>, steps: u64) -> (Vec<(u32, u32)>, Vec<(u32, [f64; 3])>) {
+fn step(cubes: Vec<Cube<Pmb>>, steps: u64) -> Outcome {
     let out = parallel::on_threads(cubes, |mut c| {
         c.start();
         for _ in 0..steps {

@@ -31,6 +31,7 @@ pub fn run_rank<M: Model>(
     ranks: usize,
     transport: Box<dyn Transport>,
 ) -> Result<Option<Summary>, String> {
+    crate::input::setup::memory::guard_per_rank::<M>(scene, ranks).map_err(|e| e.to_string())?;
     let procs = opts.procs.clone().unwrap_or(scene.parallel.procs.clone());
     let walls = opts.walls.unwrap_or(scene.parallel.walls);
     let parts = part::parts(scene, &procs, walls, ranks).map_err(|e| {

@@ -113,10 +113,8 @@ impl SceneSites {
     }
 
     fn grow_box(&mut self, p: Vec3) {
-        for e in 0..3 {
-            self.lo[e] = self.lo[e].min(p[e]);
-            self.hi[e] = self.hi[e].max(p[e]);
-        }
+        self.lo = [0, 1, 2].map(|e| self.lo[e].min(p[e]));
+        self.hi = [0, 1, 2].map(|e| self.hi[e].max(p[e]));
     }
 
     /// The material of the lattice site `key`, if it is filled.

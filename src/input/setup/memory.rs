@@ -68,7 +68,7 @@ const COUNTED_RADIUS: f64 = 40.0;
 
 /// Lattice sites within `radius` of an interior site (bonds or pairs of one particle).
 fn neighbours(lattice: &geometry::Lattice, radius: f64) -> f64 {
-    if !(radius > COUNTED_RADIUS * lattice.spacing) {
+    if radius.is_nan() || radius <= COUNTED_RADIUS * lattice.spacing {
         return geometry::neighbours_within(lattice, radius) as f64;
     }
     let ball = 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3);
@@ -115,6 +115,33 @@ pub fn guard<M: Model>(scene: &Scene, reach: f64) -> Result<Estimate, DeckError>
         // The builder reports what is wrong with the geometry.
         return Ok(Estimate::default());
     };
+    let remedy = "; more MPI ranks do not help, as every rank of this deck builds the whole scene (docs/wall_method.md, setup per rank)";
+    refuse_beyond(scene, e, 1.0, remedy)
+}
+
+/// Peak resident memory of a rank that builds only its procCube (`parallel::part`), over its
+/// share of the records, as measured (docs/performance.md, memory guard).
+const PER_RANK_PEAK_OVER_RECORDS: f64 = 1.5;
+
+/// [`guard`] for a run whose `ranks` ranks each build only their procCube: each needs about
+/// its share of the records.
+pub fn guard_per_rank<M: Model>(scene: &Scene, ranks: usize) -> Result<Estimate, DeckError> {
+    let Some(mut e) = estimate::<M>(scene, 0.0) else {
+        return Ok(Estimate::default());
+    };
+    e.peak = PER_RANK_PEAK_OVER_RECORDS * e.records / ranks.max(1) as f64;
+    let remedy = ", or more MPI ranks on more machines (each rank builds only its procCube)";
+    refuse_beyond(scene, e, ranks as f64, remedy)
+}
+
+/// `e` if its peak, times the ranks on this machine, fits what this process may have; else the
+/// error with the numbers and the remedies.
+fn refuse_beyond(
+    scene: &Scene,
+    e: Estimate,
+    ranks: f64,
+    remedy: &str,
+) -> Result<Estimate, DeckError> {
     let Some((free, source)) = available() else {
         return Ok(e);
     };
@@ -123,15 +150,20 @@ pub fn guard<M: Model>(scene: &Scene, reach: f64) -> Result<Estimate, DeckError>
         return Ok(e);
     }
     let gib = |b: f64| b / (1u64 << 30) as f64;
-    let ranks = if here > 1.0 {
+    let on_machine = if here > 1.0 {
         format!(" × {here} ranks on this machine")
+    } else {
+        String::new()
+    };
+    let share = if ranks > 1.0 {
+        format!(" for each of {ranks} ranks")
     } else {
         String::new()
     };
     Err(scene.error(
         None,
         format!(
-            "the scene will not fit in memory: {:.3e} particles and about {:.3e} bonds{} need about {:.1} GiB to set up ({:.1} GiB of particle and bond records × {PEAK_OVER_RECORDS}, the measured peak of setup){ranks}, and this process may have {:.1} GiB ({source}). Nothing was allocated. Remedies: a coarser lattice (twice the spacing: 1/8 of the particles and bonds), a smaller horizon (m = 3 → 2: about 1/3.4 of the bonds), fewer or smaller [[geometry]] entries, or a machine with more memory; more MPI ranks do not help yet, as every rank builds the whole scene",
+            "the scene will not fit in memory: {:.3e} particles and about {:.3e} bonds{} need about {:.1} GiB{share} to set up ({:.1} GiB of particle and bond records in all, × the measured peak of setup over them){on_machine}, and this process may have {:.1} GiB ({source}). Nothing was allocated. Remedies: a coarser lattice (twice the spacing: 1/8 of the particles and bonds), a smaller horizon (m = 3 → 2: about 1/3.4 of the bonds), fewer or smaller [[geometry]] entries, or a machine with more memory{remedy}",
             e.particles,
             e.bonds,
             if e.pairs > 0.0 { format!(" and {:.3e} neighbour pairs", e.pairs) } else { String::new() },
