@@ -846,3 +846,28 @@ fn prestrain_given_twice_or_transfer_length_alone() {
         Some(line),
     );
 }
+
+/// More workers than any machine has: refused at `[parallel]` (found by tests/deck_fuzz.rs:
+/// `threads = 100000000000` kept the layout search going for hours, and two procCube counts
+/// of 2³² multiplied to 0 procCubes).
+#[test]
+fn absurd_worker_counts() {
+    let deck = format!("{BASE}\n[parallel]\nthreads = 100000000000\n");
+    let line = line_of(&deck, "[parallel]");
+    assert_rejected(
+        "threads_huge",
+        &deck,
+        &["threads = 100000000000", "at most 1048576"],
+        Some(line),
+    );
+    let deck = format!("{BASE}\n[parallel]\nprocs = [4294967296, 4294967296, 1]\nthreads = 1\n");
+    assert_rejected(
+        "procs_overflow",
+        &deck,
+        &[
+            "procs = [4294967296, 4294967296, 1]",
+            "more than 1048576 procCubes",
+        ],
+        Some(line),
+    );
+}

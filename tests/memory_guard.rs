@@ -72,3 +72,21 @@ fn a_scene_too_large_for_the_machine_is_refused_with_the_estimate_and_remedies()
     assert!(e.contains("will not fit in memory"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_horizon_of_a_million_spacings_is_refused_at_once() {
+    // Found by tests/deck_fuzz.rs: the estimate counted the sites within the horizon one by
+    // one, (2·10⁶)³ of them, and `pdq check` never ended.
+    let text = std::fs::read_to_string("inputs/pmb_block.toml")
+        .unwrap()
+        .replace("horizon = \"3.015 mm\"", "m = 1e6");
+    let scene = deck::parse(&text, "pmb_block_wide.toml", "wide").unwrap();
+    let start = std::time::Instant::now();
+    let e = check(&scene).unwrap_err();
+    assert!(e.contains("will not fit in memory"), "{e}");
+    assert!(
+        start.elapsed().as_secs_f64() < 5.0,
+        "took {:?}",
+        start.elapsed()
+    );
+}

@@ -366,18 +366,7 @@ fn stable_step<M: Model, T: Transport>(
     }];
     t.reduce(&mut gid, Reduce::Min);
     let dt = dt[0];
-    if dt.is_nan() || dt <= 0.0 {
-        return Err(scene.error(
-            None,
-            format!("the stable time step is {dt:e}: check the materials' stiffness and density"),
-        ));
-    }
-    if !dt.is_finite() && M::BONDED {
-        return Err(scene.error(
-            None,
-            "no particle has a bond: the horizon is too small for the particle spacing",
-        ));
-    }
+    crate::input::setup::check_stable_step::<M>(scene, dt)?;
     Ok((dt, gid[0] as u32))
 }
 

@@ -78,19 +78,7 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
     let (mut particles, cloud_bar, domain, gid_to_index) = particles(&model, scene, reach)?;
     let (bonds, correction, bars) = bonds(&model, &mut particles, scene, cloud_bar)?;
     let (dt_critical, dt_critical_particle) = stable_time_step(&model, &particles, &bonds);
-    if dt_critical.is_nan() || dt_critical <= 0.0 {
-        return Err(scene.error(
-            None,
-            format!("the stable time step is {dt_critical:e}: check the materials' stiffness and density"),
-        ));
-    }
-    // A bondless model has no stable step; its deck gives dt (checked with `[time]`).
-    if !dt_critical.is_finite() && M::BONDED {
-        return Err(scene.error(
-            None,
-            "no particle has a bond: the horizon is too small for the particle spacing",
-        ));
-    }
+    check_stable_step::<M>(scene, dt_critical)?;
     let index = |g: u32| gid_to_index.get(g as usize).copied();
     let scope = place::Scope::whole(&index, gid_to_index.len());
     place::initial_state(&mut particles, scene, &scope)?;
@@ -140,6 +128,24 @@ pub fn build<M: Model>(model: M, scene: &Scene) -> Result<Setup<M>, DeckError> {
         bars,
         memory,
     })
+}
+
+/// Refuses a stable step that is not a positive number, or none at all for a bonded model.
+pub fn check_stable_step<M: Model>(scene: &Scene, dt_critical: f64) -> Result<(), DeckError> {
+    if dt_critical.is_nan() || dt_critical <= 0.0 {
+        return Err(scene.error(
+            None,
+            format!("the stable time step is {dt_critical:e}: check the materials' stiffness and density"),
+        ));
+    }
+    // A bondless model has no stable step; its deck gives dt (checked with `[time]`).
+    if !dt_critical.is_finite() && M::BONDED {
+        return Err(scene.error(
+            None,
+            "no particle has a bond: the horizon is too small for the particle spacing",
+        ));
+    }
+    Ok(())
 }
 
 /// The deck's particles, stored in cell order so that bond partners are near each other in
