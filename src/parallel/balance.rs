@@ -7,6 +7,14 @@ use crate::engine::cells::{Domain, HALF_SHELL};
 
 /// The particles of each cell of a grid: where each cell's run starts in the store, and the
 /// store order (see [`Layout::with_cells`]).
+/// [`Cells`] of a store of particles at `x0`.
+fn binned(x0: &[[f64; 3]]) -> impl Fn(&Domain) -> (Vec<u32>, Vec<u32>) + '_ {
+    |d: &Domain| {
+        let (_, start, order) = d.grid.bin(x0);
+        (start, order)
+    }
+}
+
 pub type Cells<'a> = dyn Fn(&Domain) -> (Vec<u32>, Vec<u32>) + 'a;
 
 /// Bond work of each layer of cells along each axis: what a procCube taking those layers
@@ -66,10 +74,7 @@ impl Layout {
         x0: &[[f64; 3]],
         walls: Walls,
     ) -> Result<Layout, String> {
-        Layout::with_cells(procs, base, walls, &|d: &Domain| {
-            let (_, start, order) = d.grid.bin(x0);
-            (start, order)
-        })
+        Layout::with_cells(procs, base, walls, &binned(x0))
     }
 
     /// [`Layout::new`] with the particles of each cell from `cells`: the start of each cell's
@@ -125,10 +130,7 @@ impl Layout {
         x0: &[[f64; 3]],
         walls: Walls,
     ) -> Result<Layout, String> {
-        Layout::auto_with_cells(workers, domain, walls, &|d: &Domain| {
-            let (_, start, order) = d.grid.bin(x0);
-            (start, order)
-        })
+        Layout::auto_with_cells(workers, domain, walls, &binned(x0))
     }
 
     /// [`Layout::auto`] with the particles of each cell from `cells` (see [`Layout::with_cells`]).

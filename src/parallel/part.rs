@@ -88,18 +88,9 @@ pub fn parts(scene: &Scene, procs: &Procs, walls: Walls, workers: usize) -> Resu
 
 /// The scene's sites, with deck errors pointing at the entry that caused them.
 fn scene_sites(scene: &Scene) -> Result<SceneSites, DeckError> {
-    use crate::input::geometry::Op;
     let ops = scene.geometry_ops();
-    SceneSites::new(&scene.lattice, &ops, &scene.geometry_bars()).map_err(|e| {
-        let subtract = |o: &Op| e.empty && matches!(o, Op::Subtract { .. });
-        let last_subtract = ops.iter().rposition(subtract).map(|k| scene.ops[k].line);
-        let line = e
-            .entry
-            .map(|k| scene.ops[k].line)
-            .or(e.bar.map(|k| scene.bars[k].line))
-            .or(last_subtract);
-        scene.error(line, e.message.clone())
-    })
+    SceneSites::new(&scene.lattice, &ops, &scene.geometry_bars())
+        .map_err(|e| crate::input::setup::geometry_error(scene, &ops, &e))
 }
 
 /// Particles per cell of `domain`'s grid, as `Layout::with_cells` takes them (no store order).

@@ -158,17 +158,8 @@ fn particles<M: Model>(
     reach: f64,
 ) -> Result<(Particles<M>, Vec<u32>, Domain, Vec<u32>), DeckError> {
     let ops = scene.geometry_ops();
-    let cloud = geometry::build(&scene.lattice, &ops, &scene.geometry_bars()).map_err(|e| {
-        // An empty scene is blamed on the last subtraction, the usual culprit.
-        let subtract = |o: &geometry::Op| e.empty && matches!(o, geometry::Op::Subtract { .. });
-        let last_subtract = ops.iter().rposition(subtract).map(|k| scene.ops[k].line);
-        let line = e
-            .entry
-            .map(|k| scene.ops[k].line)
-            .or(e.bar.map(|k| scene.bars[k].line))
-            .or(last_subtract);
-        scene.error(line, e.message.clone())
-    })?;
+    let cloud = geometry::build(&scene.lattice, &ops, &scene.geometry_bars())
+        .map_err(|e| geometry_error(scene, &ops, &e))?;
     let domain = domain(&cloud.position, scene, reach)?;
     let (_, _, order) = domain.grid.bin(&cloud.position);
     let gid: Vec<u32> = order.clone();
@@ -181,6 +172,23 @@ fn particles<M: Model>(
     }
     let particles = Particles::new(model, gid, x0, volume, material);
     Ok((particles, cloud.bar, domain, gid_to_index))
+}
+
+/// A geometry error as a deck error at the entry or bar that caused it; an empty scene is
+/// blamed on the last subtraction, the usual culprit.
+pub fn geometry_error(
+    scene: &Scene,
+    ops: &[geometry::Op],
+    e: &geometry::GeometryError,
+) -> DeckError {
+    let subtract = |o: &geometry::Op| e.empty && matches!(o, geometry::Op::Subtract { .. });
+    let last_subtract = ops.iter().rposition(subtract).map(|k| scene.ops[k].line);
+    let line = e
+        .entry
+        .map(|k| scene.ops[k].line)
+        .or(e.bar.map(|k| scene.bars[k].line))
+        .or(last_subtract);
+    scene.error(line, e.message.clone())
 }
 
 /// The bonds within the horizon, with the surface correction if the deck asks for it and the
