@@ -263,7 +263,7 @@ fn main() -> ExitCode {
         Cmd::Run(a) => run_deck(a),
         Cmd::Validate(a) => validate(a).map(|()| false),
         Cmd::Stress(a) => stress(a).map(|()| false),
-        Cmd::Info { file } => pdq::output::checkpoint::info(&file).map(|s| {
+        Cmd::Info { file } => pdq::output::info::info(&file).map(|s| {
             print!("{s}");
             false
         }),

@@ -254,7 +254,7 @@ fn static_start<M: Model>(
             s.broken
         )));
     }
-    s.state.restore_particles(setup);
+    s.state.restore_particles(&mut setup.sim);
     Ok(s)
 }
 
@@ -352,11 +352,13 @@ impl<M: Model> Prepared<'_, M> {
         self.say_static(quiet.quiet);
         let plans = crate::parallel::decomposition::cell_plans(&layout);
         let cube = parallel::build_cube(&self.setup, &layout, &plans, rank, Box::new(mpi));
-        let p = self.plan(&layout);
+        let mut p = self.plan(&layout);
+        // Every rank holds the whole scene here, but the output is the same as a per-rank
+        // setup's: in parts on several ranks.
+        p.in_parts = scene.output.in_parts(ranks, true);
         let (setup, start) = self.into_start();
-        let start = start.as_ref();
-        let store = (rank == 0).then(|| frame_store(setup));
-        match drive(cube, &p, store, start)? {
+        let store = (rank == 0 && ranks > 1 && !p.in_parts).then(|| frame_store(setup));
+        match drive(cube, &p, store, start.as_ref())? {
             Some(s) => {
                 report(&s, opts, scene.output.frames_every > 0);
                 Ok(s)
@@ -383,10 +385,14 @@ impl<M: Model> Prepared<'_, M> {
         )?;
         self.say_static(opts.quiet);
         let cubes = parallel::thread_cubes(&self.setup, &layout);
-        let p = self.plan(&layout);
+        let mut p = self.plan(&layout);
+        p.in_parts = scene.output.in_parts(cubes.len(), false);
         let (setup, start) = self.into_start();
         let start = start.as_ref();
-        let store = std::sync::Mutex::new(Some(frame_store(setup)));
+        // One procCube writes its frames itself, and so do procCubes writing in parts;
+        // otherwise the root gathers them.
+        let gathered = cubes.len() > 1 && !p.in_parts;
+        let store = std::sync::Mutex::new(gathered.then(|| frame_store(setup)));
         let results = parallel::on_threads(cubes, |cube| {
             let s = if cube.plan.rank == 0 {
                 store.lock().unwrap().take()
@@ -416,7 +422,23 @@ fn resume_from<M: Model>(
     start: f64,
 ) -> Result<Checkpoint, String> {
     let (path, c) = checkpoint::resolve(from)?;
-    c.check_matches::<M>(&path, scene_hash, setup.sim.particles.len())?;
+    let n = setup.sim.particles.len();
+    check_resume(&c, &path, (scene_hash, n), (start, setup.steps), &setup.sim)?;
+    c.state.restore_particles(&mut setup.sim);
+    Ok(c)
+}
+
+/// Refuses a checkpoint that is not of this deck's scene (`scene`: its hash and particle
+/// count), or whose run started at another time or integrated otherwise than `sim`, or that is
+/// past the run's end (`run`: its start time and last step).
+pub(super) fn check_resume<M: Model>(
+    c: &Checkpoint,
+    path: &std::path::Path,
+    (scene_hash, n): (u64, usize),
+    (start, steps): (f64, u64),
+    sim: &crate::engine::simulation::Simulation<M>,
+) -> Result<(), String> {
+    c.check_matches::<M>(path, scene_hash, n)?;
     // Steps count from the run's start (`[time] static_until`, or 0): a checkpoint of a run
     // that started elsewhere would end the restart at another time.
     let began = c.state.time - c.state.step as f64 * c.state.dt;
@@ -428,7 +450,6 @@ fn resume_from<M: Model>(
             c.state.time
         ));
     }
-    let sim = &setup.sim;
     if c.state.dt != sim.dt || checkpoint::integrator(&c.state.integrator) != Some(sim.integrator) {
         return Err(format!(
             "checkpoint {}: it was written with time step {:e} ({}), the deck now gives {:e} ({}); a restart continues with the same integration",
@@ -439,16 +460,14 @@ fn resume_from<M: Model>(
             sim.integrator.name()
         ));
     }
-    if c.state.step >= setup.steps {
+    if c.state.step >= steps {
         return Err(format!(
-            "checkpoint {} is at step {}, the run ends at step {}: nothing to do (give more steps with --steps)",
+            "checkpoint {} is at step {}, the run ends at step {steps}: nothing to do (give more steps with --steps)",
             path.display(),
             c.state.step,
-            setup.steps
         ));
     }
-    c.state.restore_particles(setup);
-    Ok(c)
+    Ok(())
 }
 
 /// Creates the output directory and prints what is about to run.
@@ -627,5 +646,6 @@ pub(super) fn run_plan(
         title: scene.title.clone(),
         analyses: facts.analyses,
         deform: scene.deform.clone(),
+        in_parts: false,
     }
 }

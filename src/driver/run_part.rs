@@ -1,11 +1,11 @@
 //! `pdq run` with setup per rank (`parallel::part`): each worker builds only its procCube from
 //! the geometry, so that its memory is its share of the scene, and then steps it as any run.
 //! Used under `mpirun` when the deck has nothing `part::unsupported` names (the whole-scene
-//! setup builds those) and is not a restart; `run_on_threads` runs it on threads (tests).
+//! setup builds those); `run_on_threads` runs it on threads (tests).
 //!
-//! Until frames and checkpoints are written in parts, the root keeps the scene's particles
-//! (no bonds) for gathering them: its memory is its procCube plus about a hundred bytes per
-//! particle of the scene.
+//! Frames and checkpoints are written in parts, and a restart reads its procCube's share of a
+//! checkpoint a part at a time, so no rank holds the whole scene. Only with `[output] parts =
+//! false` does the root keep the scene's particles (no bonds) to gather the frames into.
 
 use super::record::{columns_of, FrameStore};
 use super::run::{analysis_plans_at, run_plan, RunFacts, RunOptions, Summary};
@@ -14,12 +14,14 @@ use crate::engine::particles::Particles;
 use crate::input::deck::Scene;
 use crate::input::geometry::SceneSites;
 use crate::model::{Model, ModelVisitor};
+use crate::output::checkpoint::Checkpoint;
 use crate::parallel::comm::{Team, Transport};
 use crate::parallel::part::{self, Parts};
 
 /// Whether `pdq run` builds this deck per rank under `mpirun`.
 pub fn per_rank(scene: &Scene, opts: &RunOptions) -> bool {
-    part::unsupported(scene).is_none() && opts.restart.is_none() && scene.output.restart.is_none()
+    let _ = opts;
+    part::unsupported(scene).is_none()
 }
 
 /// Runs procCube `rank` of `ranks` over `transport`, built on its own; the root's summary.
@@ -48,10 +50,21 @@ pub fn run_rank<M: Model>(
             anchor = s.position;
         }
     });
-    let store = (rank == 0).then(|| whole_store(&model, &parts.sites));
+    let in_parts = scene.output.in_parts(ranks, true);
+    let gathered = rank == 0 && ranks > 1 && !in_parts;
+    let store = gathered.then(|| whole_store(&model, &parts.sites));
     let mut ps =
         part::build_part(model, scene, &parts, rank, transport).map_err(|e| e.to_string())?;
     let steps = opts.steps.unwrap_or(ps.steps);
+    let resume = match opts.restart.as_ref().or(scene.output.restart.as_ref()) {
+        Some(from) => Some(resume_part(
+            &mut ps.cube,
+            from,
+            (scene_hash, parts.sites.len()),
+            steps,
+        )?),
+        None => None,
+    };
     let dir = opts
         .output
         .clone()
@@ -62,6 +75,12 @@ pub fn run_rank<M: Model>(
     if rank == 0 && !opts.quiet {
         eprint!("{}", describe::<M>(scene, &parts, &ps, bonds, steps, ranks));
         eprintln!("output     {}", dir.display());
+        if let Some(c) = &resume {
+            eprintln!(
+                "restart    from step {} (t = {:.6e}) of {}, read by each rank for its procCube",
+                c.state.step, c.state.time, c.deck
+            );
+        }
     }
     let probes: Vec<&str> = scene.probes.iter().map(|p| p.name.as_str()).collect();
     let facts = RunFacts {
@@ -72,21 +91,41 @@ pub fn run_rank<M: Model>(
         horizon: scene.horizon,
         thermo: None,
         analyses: analysis_plans_at(anchor, scene),
-        first_step: 0,
+        first_step: resume.as_ref().map_or(0, |c| c.state.step),
         static_evaluations: 0,
         solver: SolverChoice::Explicit,
         scene_hash,
     };
-    let plan = run_plan(facts, scene, opts, &dir, &parts.layout);
+    let mut plan = run_plan(facts, scene, opts, &dir, &parts.layout);
+    plan.in_parts = in_parts;
     ps.cube.sim.timing.add(
         crate::engine::timing::Phase::Setup,
         std::time::Duration::from_secs_f64(ps.seconds),
     );
-    let summary = drive(ps.cube, &plan, store, None)?;
+    let summary = drive(ps.cube, &plan, store, resume.as_ref().map(|c| &c.state))?;
     if let Some(s) = &summary {
         super::run::report(s, opts, scene.output.frames_every > 0);
     }
     Ok(summary)
+}
+
+/// Reads the share of procCube `cube` (its owned particles and ghosts, and the bonds between
+/// them) of the checkpoint to resume from, a part at a time, checks that it belongs to this
+/// deck (`scene`: its hash and particle count) and run of `steps`, and puts its particles in.
+fn resume_part<M: Model>(
+    cube: &mut crate::parallel::Cube<M>,
+    from: &std::path::Path,
+    scene: (u64, usize),
+    steps: u64,
+) -> Result<Checkpoint, String> {
+    let mut local = cube.sim.particles.gid.clone();
+    local.sort_unstable();
+    let keep = |g: u32| local.binary_search(&g).is_ok();
+    let (path, c) = crate::output::checkpoint::resolve_some(from, Some(&keep))?;
+    // Decks with a static start are built whole (`part::unsupported`): runs start at t = 0.
+    super::run::check_resume(&c, &path, scene, (0.0, steps), &cube.sim)?;
+    c.state.restore_particles(&mut cube.sim);
+    Ok(c)
 }
 
 /// The hash a checkpoint of this scene carries, streamed from the geometry in id order (the

@@ -51,6 +51,9 @@ pub(crate) struct Plan {
     pub analyses: Vec<super::observers::analysis::AnalysisPlan>,
     /// `[deform]`: the periodic box changing with time.
     pub deform: Option<crate::input::deck::DeformSpec>,
+    /// Frames and checkpoints are written in parts, one per procCube, instead of gathered on
+    /// the root (runs on several MPI ranks).
+    pub in_parts: bool,
 }
 
 /// When to write checkpoints, and what identifies them.

@@ -10,6 +10,10 @@
 //!
 //! Files are written under a temporary name, synced and renamed (`output::write_atomically`):
 //! a run killed while writing leaves the previous checkpoint whole.
+//!
+//! A run on several MPI ranks writes its checkpoints in parts (`checkpoint_parts`): each
+//! procCube its own file, and an index, under the name a one-file checkpoint would have,
+//! written last.
 
 use crate::engine::simulation::Integrator;
 use crate::input::setup::Setup;
@@ -22,13 +26,18 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// What identifies the file as a PDQ checkpoint, and its layout version.
-const FORMAT: &str = "pdq-checkpoint";
-const VERSION: i64 = 1;
+pub(crate) const FORMAT: &str = "pdq-checkpoint";
+/// One procCube's part of a checkpoint written in parts: a checkpoint of the particles it
+/// lists in its `id` dataset.
+pub(crate) const PART_FORMAT: &str = "pdq-checkpoint-part";
+pub(crate) const VERSION: i64 = 1;
 
 /// A run's state at the end of a step, by global id, and what identifies its scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Checkpoint {
     pub state: Snapshot,
+    /// Particles in the scene (the snapshot may hold only some).
+    pub particles: usize,
     pub scene_hash: u64,
     /// The deck file the run was started from (informational).
     pub deck: String,
@@ -94,9 +103,15 @@ pub fn scene_hash_of<M: Model>(
     h.0
 }
 
-fn checksum(c: &Checkpoint) -> u64 {
+pub(crate) fn checksum(c: &Checkpoint) -> u64 {
     let mut h = Fnv::new();
     h.bytes(&c.state.step.to_le_bytes());
+    // Only in parts, whose checksums cover which particles they hold.
+    if let Some(ids) = &c.state.ids {
+        for g in ids {
+            h.bytes(&g.to_le_bytes());
+        }
+    }
     h.f64s(&[c.state.time, c.state.dt]);
     for x in &c.state.x0 {
         h.f64s(x);
@@ -127,6 +142,7 @@ impl Checkpoint {
     pub fn gather<M: Model>(cube: &mut Cube<M>, scene_hash: u64, deck: &str) -> Option<Checkpoint> {
         Some(Checkpoint {
             state: Snapshot::gather(cube)?,
+            particles: cube.global_particles,
             scene_hash,
             deck: deck.to_string(),
         })
@@ -137,9 +153,18 @@ impl Checkpoint {
     pub fn write(&self, dir: &Path, keep: usize) -> std::io::Result<(PathBuf, u64)> {
         std::fs::create_dir_all(dir)?;
         let path = dir.join(file_name(self.state.step));
+        crate::output::write_atomically(&path, self.builder(FORMAT), pause())?;
+        let size = std::fs::metadata(&path)?.len();
+        prune(dir, keep);
+        Ok((path, size))
+    }
+
+    /// The HDF5 file of the checkpoint, marked as `format`; a snapshot of some particles
+    /// lists them in an `id` dataset.
+    pub(crate) fn builder(&self, format: &str) -> hdf5_pure::FileBuilder {
         let mut b = hdf5_pure::FileBuilder::new();
         let s = |v: &str| AttrValue::String(v.to_string());
-        b.set_attr("format", s(FORMAT));
+        b.set_attr("format", s(format));
         b.set_attr("version", AttrValue::I64(VERSION));
         b.set_attr("step", AttrValue::U64(self.state.step));
         b.set_attr("time", AttrValue::F64(self.state.time));
@@ -150,12 +175,16 @@ impl Checkpoint {
         b.set_attr("scene_hash", AttrValue::U64(self.scene_hash));
         b.set_attr("deck", s(&self.deck));
         b.set_attr("particles", AttrValue::U64(self.state.x0.len() as u64));
+        b.set_attr("scene_particles", AttrValue::U64(self.particles as u64));
         b.set_attr(
             "broken_bonds",
             AttrValue::U64(self.state.broken.len() as u64),
         );
         b.set_attr("checksum", AttrValue::U64(checksum(self)));
         let n = self.state.x0.len() as u64;
+        if let Some(ids) = &self.state.ids {
+            b.create_dataset("id").with_u32_data(ids);
+        }
         let x0: Vec<f64> = self.state.x0.iter().flatten().copied().collect();
         b.create_dataset("x0")
             .with_f64_data(&x0)
@@ -202,36 +231,74 @@ impl Checkpoint {
                 .with_f64_data(&t.values)
                 .with_shape(&[t.values.len() as u64, 1]);
         }
-        // A testing aid (tests/checkpoint.rs kills a run while it writes); not for users.
-        let pause = std::env::var("PDQ_CHECKPOINT_PAUSE_MS")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .map(std::time::Duration::from_millis);
-        crate::output::write_atomically(&path, b, pause)?;
-        let size = std::fs::metadata(&path)?.len();
-        let mut old = list(dir);
-        old.sort_unstable();
-        if old.len() > keep.max(1) {
-            for (_, p) in &old[..old.len() - keep.max(1)] {
-                let _ = std::fs::remove_file(p);
-            }
-        }
-        Ok((path, size))
+        b
     }
 
     /// Reads and verifies a checkpoint: a file that is not one, is truncated or damaged, or
-    /// whose data do not match its checksum is refused with a message naming the file.
+    /// whose data do not match its checksum is refused with a message naming the file. A
+    /// checkpoint written in parts is read whole.
     pub fn read(path: &Path) -> Result<Checkpoint, String> {
+        Checkpoint::read_some(path, None)
+    }
+
+    /// [`Checkpoint::read`] of the particles `keep` names, and the bonds between two of them
+    /// (a procCube set up on its own reads its share, a part at a time); all with `None`.
+    pub fn read_some(
+        path: &Path,
+        keep: Option<&dyn Fn(u32) -> bool>,
+    ) -> Result<Checkpoint, String> {
         let what = |e: String| format!("checkpoint {}: {e}", path.display());
-        // The HDF5 reader is asked to parse whatever the file holds; a damaged file must give
-        // an error, so a panic inside it becomes one too.
-        let read = quietly(|| read_file(path));
+        let read = quietly(|| match crate::output::checkpoint_parts::is_index(path) {
+            true => crate::output::checkpoint_parts::read(path, keep),
+            false => read_file(path, PartOf::Whole).map(|c| match keep {
+                Some(keep) => c.only(keep),
+                None => c,
+            }),
+        });
         match read {
             Ok(r) => r.map_err(what),
             Err(_) => Err(what(
                 "the file is damaged (the HDF5 reader failed on it)".into(),
             )),
         }
+    }
+
+    /// The particles `keep` names and the bonds between two of them, ascending by id.
+    pub fn only(self, keep: &dyn Fn(u32) -> bool) -> Checkpoint {
+        let st = self.state;
+        let kept = (0..st.x0.len() as u32)
+            .map(|r| st.ids.as_ref().map_or(r, |ids| ids[r as usize]))
+            .filter(|&g| keep(g));
+        let rows: Vec<(u32, usize)> = kept.map(|g| (g, st.row(g).unwrap_or(0))).collect();
+        let (la, lf) = (
+            st.alter.len() / st.x0.len().max(1),
+            st.force.len() / st.x0.len().max(1),
+        );
+        let both = |&(a, b): &(u32, u32)| keep(a) && keep(b);
+        let lb = st.history.len() / st.history_pairs.len().max(1);
+        let mut history = Vec::new();
+        let mut history_pairs = Vec::new();
+        for (t, p) in st.history_pairs.iter().enumerate().filter(|(_, p)| both(p)) {
+            history_pairs.push(*p);
+            history.extend_from_slice(&st.history[t * lb..(t + 1) * lb]);
+        }
+        let state = Snapshot {
+            ids: Some(rows.iter().map(|r| r.0).collect()),
+            x0: rows.iter().map(|r| st.x0[r.1]).collect(),
+            alter: rows
+                .iter()
+                .flat_map(|r| st.alter[r.1 * la..(r.1 + 1) * la].to_vec())
+                .collect(),
+            force: rows
+                .iter()
+                .flat_map(|r| st.force[r.1 * lf..(r.1 + 1) * lf].to_vec())
+                .collect(),
+            broken: st.broken.iter().copied().filter(both).collect(),
+            history_pairs,
+            history,
+            ..st
+        };
+        Checkpoint { state, ..self }
     }
 
     /// Refuses a checkpoint written by another deck or model.
@@ -261,10 +328,10 @@ impl Checkpoint {
                 schema::<M>()
             ));
         }
-        if self.state.x0.len() != n {
+        if self.particles != n {
             return refuse(format!(
                 "it holds {} particles, the deck builds {n}",
-                self.state.x0.len()
+                self.particles
             ));
         }
         if self.scene_hash != scene_hash {
@@ -287,7 +354,7 @@ impl Checkpoint {
             self.state.time,
             self.state.dt,
             self.state.integrator,
-            self.state.x0.len(),
+            self.particles,
             fields,
             self.state.broken.len(),
             self.state.history_pairs.len()
@@ -297,7 +364,7 @@ impl Checkpoint {
 
 /// Runs `f`, turning a panic into `Err` without the panic message on stderr: the file readers
 /// must answer a damaged file with an error of their own.
-fn quietly<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
+pub(crate) fn quietly<T>(f: impl FnOnce() -> T) -> std::thread::Result<T> {
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
     let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
@@ -337,11 +404,20 @@ fn list(dir: &Path) -> Vec<(u64, PathBuf)> {
 /// The checkpoint to resume from: `path` itself if it is a file; if it is a directory (an
 /// output directory or its `checkpoints/`), the newest checkpoint in it that reads whole.
 pub fn resolve(path: &Path) -> Result<(PathBuf, Checkpoint), String> {
+    resolve_some(path, None)
+}
+
+/// [`resolve`], reading only the particles `keep` names and the bonds between two of them
+/// ([`Checkpoint::read_some`]).
+pub fn resolve_some(
+    path: &Path,
+    keep: Option<&dyn Fn(u32) -> bool>,
+) -> Result<(PathBuf, Checkpoint), String> {
     if !path.is_dir() {
         if !path.exists() {
             return Err(format!("checkpoint {}: no such file", path.display()));
         }
-        return Checkpoint::read(path).map(|c| (path.to_path_buf(), c));
+        return Checkpoint::read_some(path, keep).map(|c| (path.to_path_buf(), c));
     }
     let dir = if path.join("checkpoints").is_dir() {
         path.join("checkpoints")
@@ -352,7 +428,7 @@ pub fn resolve(path: &Path) -> Result<(PathBuf, Checkpoint), String> {
     found.sort_unstable();
     let mut problems = Vec::new();
     for (_, p) in found.iter().rev() {
-        match Checkpoint::read(p) {
+        match Checkpoint::read_some(p, keep) {
             Ok(c) => return Ok((p.clone(), c)),
             Err(e) => problems.push(e),
         }
@@ -371,7 +447,7 @@ pub fn resolve(path: &Path) -> Result<(PathBuf, Checkpoint), String> {
     }
 }
 
-fn attr_u64(a: &HashMap<String, AttrValue>, name: &str) -> Result<u64, String> {
+pub(crate) fn attr_u64(a: &HashMap<String, AttrValue>, name: &str) -> Result<u64, String> {
     match a.get(name) {
         Some(AttrValue::U64(v)) => Ok(*v),
         Some(AttrValue::I64(v)) if *v >= 0 => Ok(*v as u64),
@@ -380,7 +456,7 @@ fn attr_u64(a: &HashMap<String, AttrValue>, name: &str) -> Result<u64, String> {
     }
 }
 
-fn attr_f64(a: &HashMap<String, AttrValue>, name: &str) -> Result<f64, String> {
+pub(crate) fn attr_f64(a: &HashMap<String, AttrValue>, name: &str) -> Result<f64, String> {
     match a.get(name) {
         Some(AttrValue::F64(v)) => Ok(*v),
         Some(_) => Err(format!("attribute '{name}' has the wrong type")),
@@ -388,7 +464,7 @@ fn attr_f64(a: &HashMap<String, AttrValue>, name: &str) -> Result<f64, String> {
     }
 }
 
-fn attr_string(a: &HashMap<String, AttrValue>, name: &str) -> Result<String, String> {
+pub(crate) fn attr_string(a: &HashMap<String, AttrValue>, name: &str) -> Result<String, String> {
     match a.get(name) {
         Some(AttrValue::String(v)) | Some(AttrValue::AsciiString(v)) => Ok(v.clone()),
         Some(_) => Err(format!("attribute '{name}' has the wrong type")),
@@ -396,16 +472,30 @@ fn attr_string(a: &HashMap<String, AttrValue>, name: &str) -> Result<String, Str
     }
 }
 
-fn read_file(path: &Path) -> Result<Checkpoint, String> {
+/// What a checkpoint file is expected to be: a whole checkpoint, or a part of one.
+#[derive(Clone, Copy, PartialEq)]
+pub(crate) enum PartOf {
+    Whole,
+    Part,
+}
+
+/// Reads and verifies one checkpoint file (panics of the HDF5 reader are the caller's).
+pub(crate) fn read_file(path: &Path, kind: PartOf) -> Result<Checkpoint, String> {
     let f = hdf5_pure::File::open(path).map_err(|e| format!("not a readable HDF5 file ({e})"))?;
     let a = f
         .root()
         .attrs()
         .map_err(|e| format!("cannot read its attributes ({e})"))?;
-    if attr_string(&a, "format").ok().as_deref() != Some(FORMAT) {
-        return Err(
-            "not a PDQ checkpoint (no format = \"pdq-checkpoint\" attribute; a frame file?)".into(),
-        );
+    let format = if kind == PartOf::Whole {
+        FORMAT
+    } else {
+        PART_FORMAT
+    };
+    if attr_string(&a, "format").ok().as_deref() != Some(format) {
+        return Err(format!(
+            "not a PDQ checkpoint{} (no format = \"{format}\" attribute; a frame file?)",
+            if kind == PartOf::Part { " part" } else { "" }
+        ));
     }
     let version = attr_u64(&a, "version")?;
     if version != VERSION as u64 {
@@ -414,6 +504,8 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
         ));
     }
     let n = attr_u64(&a, "particles")? as usize;
+    // Written since checkpoints come in parts; a whole one holds every particle.
+    let scene_n = attr_u64(&a, "scene_particles").map_or(n, |v| v as usize);
     let schema = attr_string(&a, "schema")?;
     let dataset = |name: &str, cols: Option<u64>| -> Result<hdf5_pure::Dataset, String> {
         let d = f
@@ -485,7 +577,7 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
     if broken
         .iter()
         .chain(&history_pairs)
-        .any(|&(a, b)| a as usize >= n || b as usize >= n || a >= b)
+        .any(|&(a, b)| a as usize >= scene_n || b as usize >= scene_n || a >= b)
         || broken.windows(2).any(|w| w[0] >= w[1])
         || history_pairs.windows(2).any(|w| w[0] >= w[1])
     {
@@ -499,6 +591,10 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
             integrator: attr_string(&a, "integrator")?,
             model: attr_string(&a, "model")?,
             schema,
+            ids: match kind {
+                PartOf::Whole => None,
+                PartOf::Part => Some(read_ids(&f, n, scene_n)?),
+            },
             x0,
             alter,
             force,
@@ -507,6 +603,7 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
             history,
             thermostat: thermostat_state(&f, &a)?,
         },
+        particles: scene_n,
         scene_hash: attr_u64(&a, "scene_hash")?,
         deck: attr_string(&a, "deck")?,
     };
@@ -516,6 +613,48 @@ fn read_file(path: &Path) -> Result<Checkpoint, String> {
         );
     }
     Ok(c)
+}
+
+/// The global ids of a part's `n` particles: ascending, below the scene's `scene_n`.
+fn read_ids(f: &hdf5_pure::File, n: usize, scene_n: usize) -> Result<Vec<u32>, String> {
+    let ids = f
+        .dataset("id")
+        .and_then(|d| d.read_u32())
+        .map_err(|e| format!("dataset 'id' is missing or unreadable ({e})"))?;
+    if ids.len() != n
+        || ids.windows(2).any(|w| w[0] >= w[1])
+        || ids.last().is_some_and(|&g| g as usize >= scene_n)
+    {
+        return Err(format!(
+            "dataset 'id' holds {} ids for {n} particles, or ids out of order or beyond the scene's {scene_n}",
+            ids.len()
+        ));
+    }
+    Ok(ids)
+}
+
+/// The testing aid `PDQ_CHECKPOINT_PAUSE_MS`: tests/checkpoint.rs kills a run while it writes
+/// a checkpoint (the pause is halfway through each file); not for users.
+pub(crate) fn pause() -> Option<std::time::Duration> {
+    std::env::var("PDQ_CHECKPOINT_PAUSE_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map(std::time::Duration::from_millis)
+}
+
+/// Deletes all but the newest `keep` checkpoints in `dir`, with their parts.
+pub(crate) fn prune(dir: &Path, keep: usize) {
+    let mut old = list(dir);
+    old.sort_unstable();
+    if old.len() > keep.max(1) {
+        for (step, p) in &old[..old.len() - keep.max(1)] {
+            // The index first: a checkpoint without its index is no longer listed.
+            let _ = std::fs::remove_file(p);
+            let _ = std::fs::remove_dir_all(
+                dir.join(crate::output::checkpoint_parts::parts_dir(*step)),
+            );
+        }
+    }
 }
 
 /// The thermostat's state, in checkpoints of runs that have one.
@@ -541,100 +680,6 @@ pub fn integrator(name: &str) -> Option<Integrator> {
     Integrator::from_name(name)
 }
 
-/// `pdq info FILE`: what a frame or checkpoint holds.
-pub fn info(path: &Path) -> Result<String, String> {
-    let f = quietly(|| hdf5_pure::File::open(path))
-        .map_err(|_| format!("{}: the file is damaged", path.display()))?
-        .map_err(|e| format!("{}: not a readable HDF5 file ({e})", path.display()))?;
-    let attrs = f
-        .root()
-        .attrs()
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    if attr_string(&attrs, "format").ok().as_deref() == Some(FORMAT) {
-        return Checkpoint::read(path).map(|c| c.describe());
-    }
-    // A frame: step, time, and its arrays.
-    let step = attr_u64(&attrs, "step")
-        .map_err(|e| format!("{}: not a PDQ frame or checkpoint ({e})", path.display()))?;
-    let time = attr_f64(&attrs, "time").map_err(|e| format!("{}: {e}", path.display()))?;
-    let model = attr_string(&attrs, "model").unwrap_or_default();
-    let mut s = format!("frame of model '{model}'\nstep       {step}\ntime       {time:.10e}\n");
-    let mut arrays = Vec::new();
-    let mut particles = 0;
-    let mut max_damage = 0.0f64;
-    let mut names = f
-        .root()
-        .datasets()
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    names.sort();
-    for name in names {
-        let d = f
-            .dataset(&name)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        let shape = d.shape().map_err(|e| format!("{}: {e}", path.display()))?;
-        if name == "points" {
-            particles = shape.first().copied().unwrap_or(0);
-        }
-        if name == "damage" {
-            if let Ok(v) = d.read_f64() {
-                max_damage = v.iter().cloned().fold(0.0, f64::max);
-            }
-        }
-        if name != "points" && name != "cells" {
-            arrays.push(format!("{name}[{}]", shape.get(1).copied().unwrap_or(1)));
-        }
-    }
-    let broken = attr_u64(&attrs, "broken_bonds").map_or("?".to_string(), |b| b.to_string());
-    s.push_str(&format!(
-        "particles  {particles}\nattributes {}\nbonds      {broken} broken; damage max {max_damage:.4}\n",
-        arrays.join(", ")
-    ));
-    Ok(s)
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn sample(step: u64) -> Checkpoint {
-        Checkpoint {
-            state: Snapshot {
-                step,
-                time: 1.25e-3,
-                dt: 2.5e-7,
-                integrator: "velocity-verlet".into(),
-                model: "concrete".into(),
-                schema: "pos:3,vel:3|plastic_stretch:1|force:3".into(),
-                x0: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.5]],
-                alter: (0..18).map(|k| k as f64 * 0.1 - 0.3).collect(),
-                force: (0..9).map(|k| -(k as f64) * 1e3).collect(),
-                broken: vec![(0, 2)],
-                history_pairs: vec![(0, 1), (1, 2)],
-                history: vec![1.5e-4, -2.0e-5],
-                thermostat: (step == 20).then(|| crate::engine::thermostat::Saved {
-                    kind: "nose-hoover".into(),
-                    values: vec![0.125, -3.5],
-                }),
-            },
-            scene_hash: 0x0123_4567_89ab_cdef,
-            deck: "beam.toml".into(),
-        }
-    }
-
-    #[test]
-    fn bond_histories_and_broken_bonds_round_trip_and_old_files_are_pruned() {
-        let dir = std::env::temp_dir().join(format!("pdq-ckpt-unit-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        for step in [10, 20, 30, 40] {
-            let (path, size) = sample(step).write(&dir, 2).unwrap();
-            assert!(size > 0);
-            assert_eq!(Checkpoint::read(&path).unwrap(), sample(step));
-        }
-        let mut kept: Vec<u64> = list(&dir).into_iter().map(|(s, _)| s).collect();
-        kept.sort_unstable();
-        assert_eq!(kept, vec![30, 40], "the newest two are kept");
-        let (_, newest) = resolve(&dir).unwrap();
-        assert_eq!(newest.state.step, 40);
-        let _ = std::fs::remove_dir_all(&dir);
-    }
-}
+#[path = "checkpoint_tests.rs"]
+mod tests;

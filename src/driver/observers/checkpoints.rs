@@ -6,7 +6,9 @@ use crate::driver::step_loop::{CheckpointPlan, Plan};
 use crate::engine::timing::Phase;
 use crate::model::Model;
 use crate::output::checkpoint::Checkpoint;
+use crate::output::checkpoint_parts::{self, PartRecord};
 use crate::parallel::comm::Reduce;
+use crate::parallel::snapshot::Snapshot;
 use crate::parallel::Cube;
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -34,6 +36,7 @@ pub(super) struct Checkpoints<'a> {
     /// When the last checkpoint was written (or the run started).
     written: Instant,
     workers: usize,
+    in_parts: bool,
 }
 
 impl<'a> Checkpoints<'a> {
@@ -43,8 +46,49 @@ impl<'a> Checkpoints<'a> {
             first: plan.first_step,
             written: Instant::now(),
             workers,
+            in_parts: plan.in_parts,
         }
     }
+}
+
+/// Writes a checkpoint of this step (a collective), keeping the newest `keep`: in parts (each
+/// procCube its own, then the root the index) or gathered on the root. The root gets the path
+/// and the bytes written; an error goes to the worker that met it, and to the root.
+pub(super) fn write_checkpoint<M: Model>(
+    cube: &mut Cube<M>,
+    ck: &CheckpointPlan,
+    keep: usize,
+    in_parts: bool,
+) -> Option<Result<(std::path::PathBuf, u64), String>> {
+    let failed = |e: std::io::Error| format!("writing checkpoint in {}: {e}", ck.dir.display());
+    if !in_parts {
+        let c = Checkpoint::gather(cube, ck.scene_hash, &ck.deck)?;
+        return Some(c.write(&ck.dir, keep).map_err(failed));
+    }
+    let c = Checkpoint {
+        state: Snapshot::local(cube),
+        particles: cube.global_particles,
+        scene_hash: ck.scene_hash,
+        deck: ck.deck.clone(),
+    };
+    let rank = cube.wall.transport().rank();
+    let part = checkpoint_parts::write_part(&ck.dir, &c, rank);
+    let mine = part.as_ref().map(|p| p.to_bytes()).unwrap_or_default();
+    let records = cube.team().gather(&mine);
+    let Some(records) = records else {
+        return part.err().map(|e| Err(failed(e)));
+    };
+    let records: Vec<Option<PartRecord>> =
+        records.iter().map(|b| PartRecord::from_bytes(b)).collect();
+    if let Some(k) = records.iter().position(|r| r.is_none()) {
+        let why = part.err().map_or(String::new(), |e| format!(": {e}"));
+        return Some(Err(format!(
+            "writing checkpoint in {}: part {k} was not written (its rank says why){why}",
+            ck.dir.display()
+        )));
+    }
+    let records: Vec<PartRecord> = records.into_iter().flatten().collect();
+    Some(checkpoint_parts::write_index(&ck.dir, &c, &records, keep).map_err(failed))
 }
 
 impl<M: Model> Observer<M> for Checkpoints<'_> {
@@ -76,19 +120,15 @@ impl<M: Model> Observer<M> for Checkpoints<'_> {
             || (ck.enabled() && last);
         if due {
             let t = Instant::now();
-            if let Some(c) = Checkpoint::gather(cube, ck.scene_hash, &ck.deck) {
-                match c.write(&ck.dir, ck.keep) {
-                    Ok((path, size)) => {
-                        watch
-                            .tally
-                            .checkpoints
-                            .push((path, size, t.elapsed().as_secs_f64()))
-                    }
-                    Err(e) => {
-                        watch.error =
-                            Some(format!("writing checkpoint in {}: {e}", ck.dir.display()))
-                    }
+            match write_checkpoint(cube, ck, ck.keep, self.in_parts) {
+                Some(Ok((path, size))) => {
+                    watch
+                        .tally
+                        .checkpoints
+                        .push((path, size, t.elapsed().as_secs_f64()))
                 }
+                Some(Err(e)) => watch.error = Some(e),
+                None => {}
             }
             self.written = Instant::now();
             cube.sim.timing.lap(Phase::Output, t);

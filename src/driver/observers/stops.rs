@@ -7,9 +7,8 @@ use crate::driver::step_loop::Plan;
 use crate::engine::timing::Phase;
 use crate::model::attributes::Attributes;
 use crate::model::Model;
-use crate::output::checkpoint::Checkpoint;
 use crate::output::Frames;
-use crate::parallel::comm::Reduce;
+use crate::parallel::comm::{f64s, Reduce};
 use crate::parallel::Cube;
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -115,37 +114,40 @@ fn first_blown_up<M: Model>(cube: &mut Cube<M>, limit: Option<f64>) -> Option<u3
 /// cause.
 fn blow_up<M: Model>(cube: &mut Cube<M>, plan: &Plan, watch: &mut Watch<M>, gid: u32) -> String {
     let step = watch.step;
-    watch.gather(cube);
+    let root = cube.wall.transport().rank() == 0;
+    if root && watch.frames.is_none() {
+        watch.frames = Frames::new(&plan.dir).ok();
+    }
+    let frame = super::frames::write_frame(cube, watch, plan, 0);
     let ck = &plan.checkpoints;
-    let checkpoint = Checkpoint::gather(cube, ck.scene_hash, &ck.deck)
-        .map(|c| c.write(&ck.dir, ck.keep.max(1) + 1));
-    let Some(store) = watch.store.as_ref() else {
+    let checkpoint =
+        super::checkpoints::write_checkpoint(cube, ck, ck.keep.max(1) + 1, plan.in_parts);
+    // The particle's reference position and material, from its procCube.
+    let p = &cube.sim.particles;
+    let mine: Vec<f64> = (0..p.n_owned)
+        .find(|&i| p.gid[i] == gid)
+        .map(|i| vec![p.x0[i][0], p.x0[i][1], p.x0[i][2], p.material[i] as f64])
+        .unwrap_or_default();
+    let Some(all) = cube.team().gather(bytemuck::cast_slice(&mine)) else {
         return "another worker stopped the run: it blew up".into();
     };
-    let mut files = Vec::new();
-    let frames = match watch.frames.take() {
-        Some(f) => Ok(f),
-        None => Frames::new(&plan.dir),
+    let Some(x) = all.iter().map(|b| f64s(b)).find(|v| v.len() == 4) else {
+        return format!("the run blew up at step {step}: particle {gid}");
     };
-    if let Ok(path) =
-        frames.and_then(|mut f| f.write(step, cube.sim.time, &store.particles, &store.damage, 0))
-    {
-        files.push(path.display().to_string());
-    }
-    if let Some(Ok((path, _))) = checkpoint {
-        files.push(path.display().to_string());
-    }
-    let i = store.index_of[gid as usize] as usize;
-    let p = &store.particles;
+    let files: Vec<String> = [frame, checkpoint.and_then(|c| c.ok()).map(|c| c.0)]
+        .into_iter()
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
     let material = plan
         .material_names
-        .get(p.material[i] as usize)
+        .get(x[3] as usize)
         .map_or("?", |s| s.as_str());
     format!(
         "the run blew up at step {step}: particle {gid} (material '{material}', reference position [{:.6e}, {:.6e}, {:.6e}]) has a position or velocity that is not finite, or moves more than half a lattice spacing per step. Likely cause: {}. For inspection: {}",
-        p.x0[i][0],
-        p.x0[i][1],
-        p.x0[i][2],
+        x[0],
+        x[1],
+        x[2],
         likely_cause(plan, cube.sim.dt),
         if files.is_empty() {
             "no file could be written".to_string()

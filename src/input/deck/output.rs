@@ -37,6 +37,7 @@ impl Converter {
             checkpoint_minutes: out.checkpoint_minutes.unwrap_or(0.0),
             checkpoint_keep: out.checkpoint_keep.unwrap_or(3),
             restart: out.restart.as_ref().map(PathBuf::from),
+            parts: out.parts,
             picture: match out.picture.as_deref() {
                 None => Some(Colouring::Auto),
                 Some("none") => None,

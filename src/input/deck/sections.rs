@@ -285,6 +285,7 @@ pub(super) struct OutputSection {
     pub(super) checkpoint_keep: Option<usize>,
     pub(super) restart: Option<String>,
     pub(super) picture: Option<String>,
+    pub(super) parts: Option<bool>,
 }
 
 #[derive(Deserialize)]

@@ -202,6 +202,17 @@ pub struct OutputSpec {
     pub restart: Option<PathBuf>,
     /// `picture.png` of the final state, coloured by this (`None`: no picture).
     pub picture: Option<Colouring>,
+    /// Frames and checkpoints in parts, one file per procCube: `Some(true)` whenever there
+    /// are several procCubes, `Some(false)` never (gathered on the root), `None` on several
+    /// MPI ranks only.
+    pub parts: Option<bool>,
+}
+
+impl OutputSpec {
+    /// Whether a run of `cubes` procCubes writes in parts; `ranks`: on MPI ranks.
+    pub fn in_parts(&self, cubes: usize, ranks: bool) -> bool {
+        cubes > 1 && self.parts.unwrap_or(ranks)
+    }
 }
 
 /// What the particles of a picture are coloured by.
