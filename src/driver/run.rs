@@ -107,13 +107,14 @@ fn on_ranks_per_rank<M: Model>(
     scene: &Scene,
     opts: &RunOptions,
 ) -> Result<Summary, String> {
-    let mpi = crate::parallel::comm_mpi::Mpi::init().ok_or("MPI was already initialized")?;
+    let (job, mpi) = crate::parallel::comm_mpi::Mpi::job().ok_or("MPI was already initialized")?;
     let (rank, ranks) = (mpi.rank(), mpi.size());
     let quiet = RunOptions {
         quiet: opts.quiet || rank != 0,
         ..opts.clone()
     };
-    match super::run_part::run_rank(model, scene, &quiet, rank, ranks, Box::new(mpi))? {
+    let result = super::run_part::run_rank(model, scene, &quiet, rank, ranks, Box::new(mpi));
+    match job.end(result)? {
         Some(s) => Ok(s),
         // Other ranks have nothing to print; a summary-less Ok ends them quietly.
         None => std::process::exit(0),
@@ -329,8 +330,20 @@ impl<M: Model> Prepared<'_, M> {
     /// One procCube per rank under `mpirun`; the root gathers the frames and the summary.
     #[cfg(feature = "mpi")]
     fn on_ranks(self) -> Result<Summary, String> {
+        let (job, mpi) =
+            crate::parallel::comm_mpi::Mpi::job().ok_or("MPI was already initialized")?;
+        let result = self.step_on_ranks(mpi);
+        match job.end(result)? {
+            Some(s) => Ok(s),
+            // Other ranks have nothing to print; a summary-less Ok ends them quietly.
+            None => std::process::exit(0),
+        }
+    }
+
+    /// [`Prepared::on_ranks`] on this rank's transport; the summary on the root.
+    #[cfg(feature = "mpi")]
+    fn step_on_ranks(self, mpi: crate::parallel::comm_mpi::Mpi) -> Result<Option<Summary>, String> {
         let (scene, opts) = (self.scene, self.opts);
-        let mpi = crate::parallel::comm_mpi::Mpi::init().ok_or("MPI was already initialized")?;
         let (rank, ranks) = (mpi.rank(), mpi.size());
         let layout = choose_layout(&self.setup, scene, opts, ranks)?;
         self.one_cube(&layout)?;
@@ -352,20 +365,18 @@ impl<M: Model> Prepared<'_, M> {
         self.say_static(quiet.quiet);
         let plans = crate::parallel::decomposition::cell_plans(&layout);
         let cube = parallel::build_cube(&self.setup, &layout, &plans, rank, Box::new(mpi));
+        crate::parallel::comm_mpi::injected_failure(rank)?;
         let mut p = self.plan(&layout);
         // Every rank holds the whole scene here, but the output is the same as a per-rank
         // setup's: in parts on several ranks.
         p.in_parts = scene.output.in_parts(ranks, true);
         let (setup, start) = self.into_start();
         let store = (rank == 0 && ranks > 1 && !p.in_parts).then(|| frame_store(setup));
-        match drive(cube, &p, store, start.as_ref())? {
-            Some(s) => {
-                report(&s, opts, scene.output.frames_every > 0);
-                Ok(s)
-            }
-            // Other ranks have nothing to print; a summary-less Ok ends them quietly.
-            None => std::process::exit(0),
+        let summary = drive(cube, &p, store, start.as_ref())?;
+        if let Some(s) = &summary {
+            report(s, opts, scene.output.frames_every > 0);
         }
+        Ok(summary)
     }
 
     /// One procCube per worker thread; the root's thread gathers the frames and the summary.

@@ -55,6 +55,8 @@ pub fn run_rank<M: Model>(
     let store = gathered.then(|| whole_store(&model, &parts.sites));
     let mut ps =
         part::build_part(model, scene, &parts, rank, transport).map_err(|e| e.to_string())?;
+    #[cfg(feature = "mpi")]
+    crate::parallel::comm_mpi::injected_failure(rank)?;
     let steps = opts.steps.unwrap_or(ps.steps);
     let resume = match opts.restart.as_ref().or(scene.output.restart.as_ref()) {
         Some(from) => Some(resume_part(

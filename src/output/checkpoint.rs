@@ -153,7 +153,7 @@ impl Checkpoint {
     pub fn write(&self, dir: &Path, keep: usize) -> std::io::Result<(PathBuf, u64)> {
         std::fs::create_dir_all(dir)?;
         let path = dir.join(file_name(self.state.step));
-        crate::output::write_atomically(&path, self.builder(FORMAT), pause())?;
+        crate::output::write_atomically(&path, self.builder(FORMAT), pause("file"))?;
         let size = std::fs::metadata(&path)?.len();
         prune(dir, keep);
         Ok((path, size))
@@ -479,6 +479,42 @@ pub(crate) enum PartOf {
     Part,
 }
 
+/// Refuses a file that is not a checkpoint of this `kind` and of this pdq's format version.
+fn check_format(a: &HashMap<String, AttrValue>, kind: PartOf) -> Result<(), String> {
+    let format = if kind == PartOf::Whole {
+        FORMAT
+    } else {
+        PART_FORMAT
+    };
+    if attr_string(a, "format").ok().as_deref() != Some(format) {
+        return Err(format!(
+            "not a PDQ checkpoint{} (no format = \"{format}\" attribute; a frame file?)",
+            if kind == PartOf::Part { " part" } else { "" }
+        ));
+    }
+    let version = attr_u64(a, "version")?;
+    if version != VERSION as u64 {
+        return Err(format!(
+            "checkpoint format version {version}, this pdq reads {VERSION}"
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses bond lists that name particles beyond the scene's `n`, or are out of order.
+fn check_bond_lists(broken: &[(u32, u32)], history: &[(u32, u32)], n: usize) -> Result<(), String> {
+    if broken
+        .iter()
+        .chain(history)
+        .any(|&(a, b)| a as usize >= n || b as usize >= n || a >= b)
+        || broken.windows(2).any(|w| w[0] >= w[1])
+        || history.windows(2).any(|w| w[0] >= w[1])
+    {
+        return Err("its bond lists name particles that do not exist or are out of order".into());
+    }
+    Ok(())
+}
+
 /// Reads and verifies one checkpoint file (panics of the HDF5 reader are the caller's).
 pub(crate) fn read_file(path: &Path, kind: PartOf) -> Result<Checkpoint, String> {
     let f = hdf5_pure::File::open(path).map_err(|e| format!("not a readable HDF5 file ({e})"))?;
@@ -486,23 +522,7 @@ pub(crate) fn read_file(path: &Path, kind: PartOf) -> Result<Checkpoint, String>
         .root()
         .attrs()
         .map_err(|e| format!("cannot read its attributes ({e})"))?;
-    let format = if kind == PartOf::Whole {
-        FORMAT
-    } else {
-        PART_FORMAT
-    };
-    if attr_string(&a, "format").ok().as_deref() != Some(format) {
-        return Err(format!(
-            "not a PDQ checkpoint{} (no format = \"{format}\" attribute; a frame file?)",
-            if kind == PartOf::Part { " part" } else { "" }
-        ));
-    }
-    let version = attr_u64(&a, "version")?;
-    if version != VERSION as u64 {
-        return Err(format!(
-            "checkpoint format version {version}, this pdq reads {VERSION}"
-        ));
-    }
+    check_format(&a, kind)?;
     let n = attr_u64(&a, "particles")? as usize;
     // Written since checkpoints come in parts; a whole one holds every particle.
     let scene_n = attr_u64(&a, "scene_particles").map_or(n, |v| v as usize);
@@ -574,15 +594,7 @@ pub(crate) fn read_file(path: &Path, kind: PartOf) -> Result<Checkpoint, String>
     } else {
         read_f64("history", lb as u64, Some(history_pairs.len()))?
     };
-    if broken
-        .iter()
-        .chain(&history_pairs)
-        .any(|&(a, b)| a as usize >= scene_n || b as usize >= scene_n || a >= b)
-        || broken.windows(2).any(|w| w[0] >= w[1])
-        || history_pairs.windows(2).any(|w| w[0] >= w[1])
-    {
-        return Err("its bond lists name particles that do not exist or are out of order".into());
-    }
+    check_bond_lists(&broken, &history_pairs, scene_n)?;
     let c = Checkpoint {
         state: Snapshot {
             step: attr_u64(&a, "step")?,
@@ -634,11 +646,15 @@ fn read_ids(f: &hdf5_pure::File, n: usize, scene_n: usize) -> Result<Vec<u32>, S
 }
 
 /// The testing aid `PDQ_CHECKPOINT_PAUSE_MS`: tests/checkpoint.rs kills a run while it writes
-/// a checkpoint (the pause is halfway through each file); not for users.
-pub(crate) fn pause() -> Option<std::time::Duration> {
+/// a checkpoint; not for users. `PDQ_CHECKPOINT_PAUSE_AT` says where the pause is: `file` (the
+/// default: halfway through each checkpoint file, or each part), `before-index` (every part
+/// on disk, the index not begun) or `index` (halfway through the index).
+pub(crate) fn pause(at: &str) -> Option<std::time::Duration> {
+    let point = std::env::var("PDQ_CHECKPOINT_PAUSE_AT").unwrap_or_else(|_| "file".into());
     std::env::var("PDQ_CHECKPOINT_PAUSE_MS")
         .ok()
         .and_then(|v| v.parse().ok())
+        .filter(|_| point == at)
         .map(std::time::Duration::from_millis)
 }
 

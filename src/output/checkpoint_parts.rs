@@ -71,7 +71,7 @@ impl PartRecord {
 pub fn write_part(dir: &Path, c: &Checkpoint, part: usize) -> std::io::Result<PartRecord> {
     let path = part_path(dir, c.state.step, part);
     std::fs::create_dir_all(path.parent().unwrap_or(dir))?;
-    crate::output::write_atomically(&path, c.builder(PART_FORMAT), pause())?;
+    crate::output::write_atomically(&path, c.builder(PART_FORMAT), pause("file"))?;
     Ok(PartRecord {
         checksum: checksum(c),
         particles: c.state.x0.len() as u64,
@@ -112,7 +112,10 @@ pub fn write_index(
     b.create_dataset("part_particles")
         .with_u64_data(&column(|p| p.particles));
     let path = dir.join(file_name(st.step));
-    crate::output::write_atomically(&path, b, None)?;
+    if let Some(d) = pause("before-index") {
+        std::thread::sleep(d);
+    }
+    crate::output::write_atomically(&path, b, pause("index"))?;
     // Parts left by an attempt on more ranks (a run killed before its index) are not this
     // checkpoint's.
     let mut k = parts.len();

@@ -37,8 +37,9 @@ pub fn launched_by_mpirun() -> bool {
 /// The MPI ranks of one run.
 pub struct Mpi {
     world: SimpleCommunicator,
-    /// Owned here so that MPI is finalized when the transport is dropped, after its last message.
-    _universe: Universe,
+    /// Owned here so that MPI is finalized when the transport is dropped, after its last message;
+    /// `None` when a [`Job`] owns it ([`Mpi::job`]).
+    _universe: Option<Universe>,
     /// MPI tags are only guaranteed up to 32767, and the collective tags of `Team` are larger,
     /// so tags travel modulo this span (`MPI_TAG_UB + 1`, 2^31 with Open MPI: exact in practice).
     tag_span: u32,
@@ -63,10 +64,25 @@ impl Mpi {
         let tag_ub = world.get_attr::<TagUb>().map_or(32767, |t| t.0).max(32767);
         Some(Mpi {
             world,
-            _universe: universe,
+            _universe: Some(universe),
             tag_span: tag_ub as u32 + 1,
             home: (provided < Threading::Serialized).then(|| std::thread::current().id()),
         })
+    }
+
+    /// Starts MPI for a run ([`Mpi::init`]): the transport, and the [`Job`] that ends MPI once
+    /// the run's result is known.
+    pub fn job() -> Option<(Job, Mpi)> {
+        let mut mpi = Mpi::init()?;
+        let universe = mpi._universe.take();
+        Some((
+            Job {
+                universe,
+                rank: mpi.rank(),
+                size: mpi.size(),
+            },
+            mpi,
+        ))
     }
 
     fn rank_in_world(&self, worker: usize) -> mpi::Rank {
@@ -84,6 +100,51 @@ impl Drop for Mpi {
         if std::thread::panicking() {
             self.world.abort(1);
         }
+    }
+}
+
+/// MPI for the length of one run, apart from the transport that the run's procCube owns.
+///
+/// A rank that meets an error the others do not (a file it cannot read, a setup that fails
+/// on its procCube alone) would otherwise return while its neighbours wait for its next
+/// message, and hang in `MPI_Finalize` while they hang in their receives. [`Job::end`]
+/// instead prints the error with the rank's number and aborts the whole job, so that every
+/// rank stops and `mpirun` names the rank that aborted.
+pub struct Job {
+    universe: Option<Universe>,
+    rank: usize,
+    size: usize,
+}
+
+impl Job {
+    /// Ends MPI after a run: finalizes it on success (and on one rank); on an error with
+    /// several ranks prints it, naming this rank, and aborts every rank (exit code 1).
+    pub fn end<T>(mut self, result: Result<T, String>) -> Result<T, String> {
+        match result {
+            Err(e) if self.size > 1 => {
+                eprintln!("error on rank {} of {}: {e}", self.rank, self.size);
+                eprintln!("stopping every rank (MPI_Abort)");
+                SimpleCommunicator::world().abort(1)
+            }
+            r => {
+                drop(self.universe.take());
+                r
+            }
+        }
+    }
+}
+
+/// The testing aid `PDQ_TEST_FAIL_RANK=K`: rank K (alone) fails once its procCube is built,
+/// as a rank meeting an error of its own would (tests/mpi_runs.rs); not for users.
+pub fn injected_failure(rank: usize) -> Result<(), String> {
+    match std::env::var("PDQ_TEST_FAIL_RANK")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+    {
+        Some(k) if k == rank => Err(format!(
+            "rank {rank} failed on purpose (PDQ_TEST_FAIL_RANK={k})"
+        )),
+        _ => Ok(()),
     }
 }
 

@@ -94,16 +94,19 @@ impl<M: Model> Watch<M> {
     }
 
     /// Fails on every worker if any worker has an output error (a reduction).
+    /// The others learn which worker failed (the highest numbered, if several).
     pub fn agree(&mut self, cube: &mut Cube<M>) -> Result<(), String> {
-        if cube
+        let me = cube.wall.transport().rank() as f64;
+        let failed = cube
             .team()
-            .max(if self.error.is_some() { 1.0 } else { 0.0 })
-            > 0.0
-        {
-            return Err(self
-                .error
-                .take()
-                .unwrap_or_else(|| "another worker failed".into()));
+            .max(if self.error.is_some() { me + 1.0 } else { 0.0 });
+        if failed > 0.0 {
+            return Err(self.error.take().unwrap_or_else(|| {
+                format!(
+                    "worker {} failed writing output (it says why)",
+                    failed as usize - 1
+                )
+            }));
         }
         Ok(())
     }
