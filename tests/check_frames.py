@@ -1,5 +1,7 @@
 """Reads a run's ParaView output (frames.xdmf and its HDF5 frames) with meshio's XDMF time
-series reader and h5py (independent readers) and checks it.
+series reader and h5py (independent readers) and checks it. Frames written in parts (one
+directory of part files per frame, a spatial collection per step in frames.xdmf) are read with
+VTK's XDMF reader (PyPI vtk), ParaView's own library, which meshio does not cover.
 
 Usage: python3 tests/check_frames.py OUTPUT_DIR [--same-as OTHER_DIR]
 
@@ -15,8 +17,40 @@ import meshio
 import numpy as np
 
 
+def in_parts(out):
+    return any(p.is_dir() for p in (out / "frames").glob("frame_*"))
+
+
+def read_series_parts(out):
+    """Times and point data of frames.xdmf when its frames are in parts: VTK's reader."""
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+    reader = vtk.vtkXdmfReader()
+    reader.SetFileName(str(out / "frames.xdmf"))
+    reader.UpdateInformation()
+    times = reader.GetOutputInformation(0).Get(vtk.vtkStreamingDemandDrivenPipeline.TIME_STEPS())
+    frames = []
+    for t in times:
+        reader.UpdateTimeStep(t)
+        blocks = reader.GetOutputDataObject(0)
+        parts = {}
+        for k in range(blocks.GetNumberOfBlocks()):
+            b = blocks.GetBlock(k)
+            assert b.GetNumberOfCells() == b.GetNumberOfPoints(), "one vertex cell per particle"
+            pd = b.GetPointData()
+            for i in range(pd.GetNumberOfArrays()):
+                parts.setdefault(pd.GetArrayName(i), []).append(vtk_to_numpy(pd.GetArray(i)))
+            parts.setdefault("points", []).append(vtk_to_numpy(b.GetPoints().GetData()))
+        data = {name: np.concatenate(v) for name, v in parts.items()}
+        assert np.array_equal(data.pop("points"), data["pos"]), "VTK's points are the positions"
+        frames.append((t, data))
+    return frames
+
+
 def read_series(out):
     """Times, and per frame the point data, of an output directory's frames.xdmf."""
+    if in_parts(out):
+        return read_series_parts(out)
     frames = []
     with meshio.xdmf.TimeSeriesReader(out / "frames.xdmf") as reader:
         points, cells = reader.read_points_cells()
@@ -33,7 +67,7 @@ frames = read_series(out)
 assert len(frames) >= 2, "a time series needs several frames"
 times = [t for t, _ in frames]
 assert times == sorted(times), "frame times must increase"
-h5_files = sorted((out / "frames").glob("frame_*.h5"))
+h5_files = sorted((out / "frames").glob("frame_*"))
 assert len(h5_files) == len(frames), (len(h5_files), len(frames))
 for (t, data), path in zip(frames, h5_files):
     n = len(data["id"])
@@ -41,9 +75,14 @@ for (t, data), path in zip(frames, h5_files):
                         ("pos", 3), ("vel", 3), ("force", 3)]:
         a = data[name]
         assert a.shape[0] == n and (a.ndim == 1 or a.shape[1] == comps), (name, a.shape)
-    with h5py.File(path, "r") as f:
-        assert abs(f.attrs["time"] - t) <= 1e-12 * max(abs(t), 1e-300), "time attribute"
-        assert np.array_equal(f["points"][()], data["pos"]), "points are current positions"
+    files = sorted(path.glob("part_*.h5")) if path.is_dir() else [path]
+    points = []
+    for file in files:
+        with h5py.File(file, "r") as f:
+            assert abs(f.attrs["time"] - t) <= 1e-12 * max(abs(t), 1e-300), "time attribute"
+            if len(f["points"]):
+                points.append(f["points"][()])
+    assert np.array_equal(np.concatenate(points), data["pos"]), "points are current positions"
     d = data["damage"]
     assert ((d >= 0) & (d <= 1)).all(), "damage lies in [0, 1]"
     assert sorted(data["id"]) == list(range(n)), "ids are 0..n-1"

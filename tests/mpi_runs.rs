@@ -263,7 +263,142 @@ fn restarts_under_mpi() {
         bb.len()
     );
     assert!(d <= 1e-12, "positions differ by {d:e}");
+    // Four ranks write the checkpoint in parts; two ranks, and one thread, resume from it.
+    let four = work.join("four");
+    mpirun_deck(4, &deck_path, &["--steps", "250"], &four);
+    let index = four.join("checkpoints/checkpoint_00000250.h5");
+    let parts = four.join("checkpoints/checkpoint_00000250.parts");
+    assert_eq!(
+        std::fs::read_dir(&parts).unwrap().count(),
+        4,
+        "one part per rank"
+    );
+    let two = work.join("four-two");
+    mpirun_deck(2, &deck_path, &["--restart", index.to_str().unwrap()], &two);
+    let (p2, b2) = read_final(&two);
+    assert_eq!(ba, b2, "-np 4 parts -> -np 2: different bonds broke");
+    let d2 = max_relative_difference(&pa, &p2);
+    let thread = work.join("four-thread");
+    run(
+        &scene,
+        &RunOptions {
+            output: Some(thread.clone()),
+            quiet: true,
+            threads: Some(1),
+            restart: Some(index.clone()),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let (p1, b1) = read_final(&thread);
+    assert_eq!(ba, b1, "-np 4 parts -> 1 thread: different bonds broke");
+    let d1 = max_relative_difference(&pa, &p1);
+    eprintln!(
+        "checkpoint in 4 parts at step 250 -> -np 2: positions within {d2:.1e}; -> 1 thread: {d1:.1e}; the same {} broken bonds",
+        b1.len()
+    );
+    assert!(
+        d2 <= 1e-12 && d1 <= 1e-12,
+        "positions differ by {d2:e}, {d1:e}"
+    );
     let _ = std::fs::remove_dir_all(work);
+}
+
+/// `mpirun -np 4` of the pull deck for many steps, with `env`; the child, not waited for.
+fn spawn_ranks(dir: &Path, env: &[(&str, &str)]) -> std::process::Child {
+    Command::new("mpirun")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .envs(env.iter().copied())
+        .args(["--oversubscribe", "-np", "4"])
+        .arg(env!("CARGO_BIN_EXE_pdq"))
+        .arg("run")
+        .arg(DECK)
+        .args(["--quiet", "--steps", "1000000", "--output"])
+        .arg(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("mpirun must be on the PATH for the MPI tests")
+}
+
+/// Waits for `child` at most `limit`; kills it and fails if it hangs; its stderr.
+fn ended_within(mut child: std::process::Child, limit: std::time::Duration, what: &str) -> String {
+    let start = std::time::Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            let out = child.wait_with_output().unwrap();
+            let err = String::from_utf8_lossy(&out.stderr).to_string();
+            assert!(
+                !status.success(),
+                "{what}: the job ended as if nothing happened\n{err}"
+            );
+            return err;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            panic!("{what}: the other ranks hang ({limit:?})");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+}
+
+/// The MPI rank (`OMPI_COMM_WORLD_RANK`) of each of `mpirun`'s children.
+fn ranks_of(mpirun: u32) -> Vec<(u32, usize)> {
+    let children = std::fs::read_to_string(format!("/proc/{mpirun}/task/{mpirun}/children"))
+        .unwrap_or_default();
+    children
+        .split_whitespace()
+        .filter_map(|pid| {
+            let env = std::fs::read(format!("/proc/{pid}/environ")).ok()?;
+            let rank = env
+                .split(|&b| b == 0)
+                .filter_map(|v| std::str::from_utf8(v).ok())
+                .find_map(|v| v.strip_prefix("OMPI_COMM_WORLD_RANK="))?
+                .parse()
+                .ok()?;
+            Some((pid.parse().ok()?, rank))
+        })
+        .collect()
+}
+
+/// A rank that meets an error alone (injected once its procCube is built, while the others
+/// wait for its ghosts) and a rank killed with SIGKILL mid-run: every rank stops within a
+/// minute and the message names the rank.
+#[test]
+fn a_rank_that_fails_or_dies_stops_every_rank() {
+    let dir = out_dir("fail-rank");
+    let child = spawn_ranks(&dir, &[("PDQ_TEST_FAIL_RANK", "2")]);
+    let err = ended_within(child, std::time::Duration::from_secs(60), "rank 2 failing");
+    assert!(err.contains("error on rank 2 of 4"), "{err}");
+    eprintln!("rank 2 failing: {}", err.lines().next().unwrap_or(""));
+    let dir = out_dir("kill-rank");
+    let child = spawn_ranks(&dir, &[]);
+    let history = dir.join("history.csv");
+    let start = std::time::Instant::now();
+    while std::fs::read_to_string(&history).map_or(0, |h| h.lines().count()) < 3 {
+        assert!(
+            start.elapsed().as_secs() < 120,
+            "the run did not start stepping"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let ranks = ranks_of(child.id());
+    let &(pid, rank) = ranks
+        .iter()
+        .find(|r| r.1 == 1)
+        .unwrap_or_else(|| panic!("no rank 1 among {ranks:?}"));
+    Command::new("kill")
+        .args(["-9", &pid.to_string()])
+        .status()
+        .unwrap();
+    let err = ended_within(child, std::time::Duration::from_secs(60), "rank 1 killed");
+    assert!(err.contains(&format!("rank {rank}")), "{err}");
+    eprintln!(
+        "rank 1 killed: {}",
+        err.lines().find(|l| l.contains("rank 1")).unwrap_or("")
+    );
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 /// Voids under MPI (issue 24): the holes deck's voids table on 2 and 4 ranks is the one

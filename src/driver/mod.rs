@@ -7,6 +7,7 @@
 mod check;
 pub mod export;
 mod observers;
+mod picture;
 pub mod post;
 mod record;
 pub mod run;

@@ -5,7 +5,7 @@ use super::run::Summary;
 use super::step_loop::{Plan, Tally};
 use crate::engine::particles::Particles;
 use crate::engine::timing::Phase;
-use crate::input::deck::{Colouring, SolverSpec};
+use crate::input::deck::SolverSpec;
 use crate::input::setup::Setup;
 use crate::model::attributes::Attributes;
 use crate::model::Model;
@@ -442,8 +442,20 @@ pub(crate) fn finish<M: Model>(
         cube.sim.strain_energy(),
     ];
     cube.team().reduce(&mut totals, Reduce::Sum);
-    let last = final_positions(&mut cube, n_global);
-    let broken_pairs = final_broken_pairs(&mut cube);
+    // Gathered on the root unless the run writes in parts and the deck did not ask for the
+    // final state: then no rank holds the scene, and the summary has neither.
+    let whole = !plan.in_parts || plan.final_state;
+    let (last, broken_pairs) = if whole {
+        (
+            final_positions(&mut cube, n_global),
+            final_broken_pairs(&mut cube),
+        )
+    } else {
+        (Final::default(), Vec::new())
+    };
+    let picture = plan
+        .picture
+        .map(|colouring| super::picture::write_picture(&mut cube, plan, colouring));
     let balance = balance_rows(&mut cube);
     let Some(balance) = balance else {
         return Ok(None);
@@ -477,8 +489,8 @@ pub(crate) fn finish<M: Model>(
     if plan.final_state {
         write_final_state(&plan.dir, &last, &broken_pairs).map_err(io)?;
     }
-    if let Some(colouring) = plan.picture {
-        write_picture(plan, &last, colouring, cube.sim.step, cube.sim.time)?;
+    if let Some(drawn) = picture {
+        drawn?;
     }
     // The results are written: a picture that cannot be drawn is reported, not fatal.
     if let Err(e) = crate::output::pictures::history_pictures(&plan.dir, &plan.title) {
@@ -559,80 +571,6 @@ struct Final {
     damage: Vec<f64>,
     material: Vec<f64>,
     velocity: Vec<[f64; 3]>,
-}
-
-/// `picture.png`: the final state from the side and in 3D, coloured as the deck asked.
-fn write_picture(
-    plan: &Plan,
-    f: &Final,
-    colouring: Colouring,
-    step: u64,
-    time: f64,
-) -> Result<(), String> {
-    let scaled = |v: &[f64], lo: f64, hi: f64| -> Vec<f64> {
-        v.iter().map(|x| (x - lo) / (hi - lo).max(1e-300)).collect()
-    };
-    let range = |v: &[f64]| {
-        v.iter()
-            .filter(|x| x.is_finite())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                (a.min(x), b.max(x))
-            })
-    };
-    let (value, scale) = match colouring {
-        Colouring::Damage => (f.damage.clone(), crate::output::plot::damage_scale()),
-        Colouring::Material => {
-            let last = plan.material_names.len().saturating_sub(1);
-            let names = &plan.material_names;
-            let ends = [
-                names.first().cloned().unwrap_or_default(),
-                names.last().cloned().unwrap_or_default(),
-            ];
-            (scaled(&f.material, 0.0, last as f64), ends)
-        }
-        Colouring::Speed => {
-            let speed: Vec<f64> = f
-                .velocity
-                .iter()
-                .map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt())
-                .collect();
-            let (_, hi) = range(&speed);
-            (
-                scaled(&speed, 0.0, hi),
-                ["speed 0".into(), format!("{hi:.3e}")],
-            )
-        }
-        // `Auto` was resolved when the run was planned.
-        Colouring::Height | Colouring::Auto => {
-            let z: Vec<f64> = f.position.iter().map(|x| x[2]).collect();
-            let (lo, hi) = range(&z);
-            (
-                scaled(&z, lo, hi),
-                [format!("z {lo:.3e}"), format!("{hi:.3e}")],
-            )
-        }
-    };
-    let what = match colouring {
-        Colouring::Material => {
-            format!("material ({}, blue to red)", plan.material_names.join(", "))
-        }
-        other => other.name().to_string(),
-    };
-    crate::output::plot::particle_views(
-        &plan.dir.join("picture.png"),
-        &format!(
-            "{}: step {step}, t = {time:.4e}, coloured by {what}",
-            plan.title
-        ),
-        &crate::output::plot::Body {
-            x0: &f.position,
-            displacement: &vec![[0.0; 3]; f.position.len()],
-            value: &value,
-            spacing: plan.spacing,
-            scale,
-        },
-        1.0,
-    )
 }
 
 /// The broken bonds as sorted (smaller, larger) global id pairs, on the root.

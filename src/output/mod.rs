@@ -19,6 +19,7 @@ pub mod pictures;
 pub mod plot;
 pub mod progress;
 pub mod signals;
+pub mod views;
 pub mod voxels;
 
 pub use atomic::write_atomically;

@@ -20,7 +20,7 @@ pub struct Series<'a> {
     pub mark: Mark,
 }
 
-fn register_font() {
+pub(crate) fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // DejaVu Sans is a valid font: registration cannot fail on it.
@@ -128,7 +128,7 @@ pub fn damage_scale() -> [String; 2] {
 
 /// 0 (blue) through yellow to 1 (dark red): for damage the thesis's figures' reading, cracks
 /// standing out against an intact body.
-fn damage_colour(d: f64) -> RGBColor {
+pub(crate) fn damage_colour(d: f64) -> RGBColor {
     let stops: [(f64, [f64; 3]); 5] = [
         (0.0, [40.0, 70.0, 160.0]),
         (0.15, [70.0, 160.0, 200.0]),
@@ -149,12 +149,10 @@ fn damage_colour(d: f64) -> RGBColor {
 }
 
 /// Writes the deformed body coloured by its values (damage, or what [`Body::scale`] names) to
-/// `path` (PNG, 1200 × 960): a side view (along +y, the x–z plane) above an oblique 3D view from the front, left and above. Displacements
-/// are drawn `magnify` times; particles are squares painted far to near, so what shows is the
-/// body's visible surface, as in the thesis's figures.
+/// `path` (PNG, 1200 × 960): a side view (along +y, the x–z plane) above an oblique 3D view
+/// from the front, left and above ([`super::views`]). Displacements are drawn `magnify` times;
+/// what shows is the body's visible surface, as in the thesis's figures.
 pub fn particle_views(path: &Path, title: &str, body: &Body, magnify: f64) -> Result<(), String> {
-    register_font();
-    let err = |e: &dyn std::fmt::Display| format!("plot {}: {e}", path.display());
     let n = body.x0.len();
     if n == 0 || body.displacement.len() != n || body.value.len() != n {
         return Err(format!("plot {}: no particles to draw", path.display()));
@@ -165,121 +163,20 @@ pub fn particle_views(path: &Path, title: &str, body: &Body, magnify: f64) -> Re
         .zip(body.displacement)
         .map(|(x, u)| [0, 1, 2].map(|k| x[k] + magnify * u[k]))
         .collect();
-    let root = BitMapBackend::new(path, (1200, 960)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let (top, rest) = root.split_vertically(40);
-    top.draw(&Text::new(
-        title.to_string(),
-        (14, 10),
-        ("sans-serif", 20).into_font(),
-    ))
-    .map_err(|e| err(&e))?;
-    let (side, oblique) = rest.split_vertically(330);
-    // Side: screen right = +x, up = +z, depth = +y (the y = min face is nearest).
-    let side_basis = ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]);
-    // Oblique: the camera looks along v from the front (−y), left (−x) and above (+z).
-    let (az, el) = (30f64.to_radians(), 22f64.to_radians());
-    let v = [az.sin() * el.cos(), az.cos() * el.cos(), -el.sin()];
-    let right = normalise(cross(v, [0.0, 0.0, 1.0]));
-    let up = cross(right, v);
-    for (area, basis, label) in [
-        (&side, side_basis, "side view (x right, z up)"),
-        (
-            &oblique,
-            (right, up, v),
-            "3D view from the front, left and above",
-        ),
-    ] {
-        draw_projection(area, &deformed, body, basis, label).map_err(|e| err(&e))?;
-    }
-    draw_colour_bar(&oblique, &body.scale).map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
+    let ids: Vec<u32> = (0..n as u32).collect();
+    let extent = super::views::extent(&deformed);
+    let pixels = super::views::raster(&deformed, &ids, body.value, body.spacing, &extent)
+        .map_err(|e| format!("plot {}: {e}", path.display()))?;
+    super::views::draw(path, title, &super::views::composite(pixels), &body.scale)
 }
 
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn normalise(a: [f64; 3]) -> [f64; 3] {
-    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-    a.map(|c| c / l)
-}
-
-fn dot(a: [f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
-
-/// Paints the particles projected on the (right, up) plane of `basis`, farthest along its
-/// depth axis first, fitted into `area` at equal scale on both axes.
-fn draw_projection(
-    area: &Area,
-    deformed: &[[f64; 3]],
-    body: &Body,
-    (right, up, depth): ([f64; 3], [f64; 3], [f64; 3]),
-    label: &str,
-) -> Result<(), Box<dyn std::error::Error>> {
-    let screen: Vec<(f64, f64, f64)> = deformed
-        .iter()
-        .map(|p| (dot(right, p), dot(up, p), dot(depth, p)))
-        .collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y, _) in screen.iter().filter(|s| s.0.is_finite() && s.1.is_finite()) {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    let (w, h) = area.dim_in_pixel();
-    let margin = 30.0;
-    let half = 0.5 * body.spacing;
-    let scale = ((w as f64 - 2.0 * margin) / (x1 - x0 + 2.0 * half))
-        .min((h as f64 - 2.0 * margin) / (y1 - y0 + 2.0 * half));
-    if !(scale.is_finite() && scale > 0.0) {
-        return Err("the body has no extent to draw".into());
-    }
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let px = |x: f64, y: f64| {
-        (
-            (0.5 * w as f64 + (x - cx) * scale).round() as i32,
-            (0.5 * h as f64 - (y - cy) * scale).round() as i32,
-        )
-    };
-    // Far first; equal depths in id order, so the picture does not depend on sort stability.
-    let mut order: Vec<usize> = (0..screen.len())
-        .filter(|&i| screen[i].0.is_finite() && screen[i].1.is_finite())
-        .collect();
-    order.sort_by(|&a, &b| screen[b].2.total_cmp(&screen[a].2).then(a.cmp(&b)));
-    // Half a pixel more than the particle's cube, so that rounding leaves no gaps.
-    let r = half * scale + 0.5;
-    for i in order {
-        let (x, y, _) = screen[i];
-        let (a, b) = (
-            px(x - r / scale, y + r / scale),
-            px(x + r / scale, y - r / scale),
-        );
-        let b = (b.0.max(a.0 + 1), b.1.max(a.1 + 1));
-        area.draw(&Rectangle::new(
-            [a, b],
-            damage_colour(body.value[i]).filled(),
-        ))?;
-    }
-    area.draw(&Text::new(
-        label.to_string(),
-        (14, 6),
-        ("sans-serif", 16).into_font(),
-    ))?;
-    Ok(())
-}
+pub(crate) type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
 /// A horizontal colour scale in the lower right corner of `area`, `ends` written at its ends.
-fn draw_colour_bar(area: &Area, ends: &[String; 2]) -> Result<(), Box<dyn std::error::Error>> {
+pub(crate) fn draw_colour_bar(
+    area: &Area,
+    ends: &[String; 2],
+) -> Result<(), Box<dyn std::error::Error>> {
     let (w, h) = area.dim_in_pixel();
     let (x0, y0, len) = (w as i32 - 330, h as i32 - 40, 240);
     for k in 0..len {
