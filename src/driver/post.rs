@@ -7,7 +7,7 @@
 //! periodic along an axis has no outside there: analyse it in situ).
 
 use crate::output::analysis::{AnalysisFiles, Found, Looking};
-use crate::output::frames::{frame_name, frame_steps, read_points};
+use crate::output::frames::{frame_path, frame_steps, part_files, read_points};
 use crate::output::pictures::{largest_clusters, LargestOf};
 use crate::output::voxels::VoxelSeries;
 use crate::parallel::comm::{Solo, Team};
@@ -59,8 +59,17 @@ pub fn voids_from_frames(dir: &Path, ask: &PostVoids) -> Result<PostSummary, Str
     let mut bytes_read = 0;
     let mut voids = 0;
     for &step in &steps {
-        let path = dir.join(frame_name(step));
-        bytes_read += std::fs::metadata(&path).map_or(0, |m| m.len());
+        // A frame's file, or the directory of its parts.
+        let path = frame_path(dir, step);
+        let on_disk = if path.is_dir() {
+            part_files(&path)?
+        } else {
+            vec![path.clone()]
+        };
+        bytes_read += on_disk
+            .iter()
+            .map(|f| std::fs::metadata(f).map_or(0, |m| m.len()))
+            .sum::<u64>();
         let frame = read_points(&path)?;
         // Voxels centred on the lattice of the particle with id 0 (as in situ).
         let anchor = frame
