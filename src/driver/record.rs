@@ -485,6 +485,17 @@ pub(crate) fn finish<M: Model>(
     if balance.len() > 1 {
         timing.push_str(&balance_table(&balance, steps));
     }
+    // With the throughput, so that timing.txt says what the checkpoints cost.
+    if let Some((_, size, secs)) = tally.checkpoints.last() {
+        let _ = writeln!(
+            timing,
+            "checkpoints: {} written, the last {:.1} MB in {:.3} s ({:.0} MB/s)",
+            tally.checkpoints.len(),
+            *size as f64 / 1e6,
+            secs,
+            *size as f64 / 1e6 / secs.max(1e-9)
+        );
+    }
     std::fs::write(plan.dir.join("timing.txt"), &timing).map_err(io)?;
     if plan.final_state {
         write_final_state(&plan.dir, &last, &broken_pairs).map_err(io)?;
@@ -495,15 +506,6 @@ pub(crate) fn finish<M: Model>(
     // The results are written: a picture that cannot be drawn is reported, not fatal.
     if let Err(e) = crate::output::pictures::history_pictures(&plan.dir, &plan.title) {
         eprintln!("warning: the history pictures were not drawn: {e}");
-    }
-    if let Some((_, size, secs)) = tally.checkpoints.last() {
-        let _ = writeln!(
-            timing,
-            "checkpoints: {} written, the last {:.1} MB in {:.3} s",
-            tally.checkpoints.len(),
-            *size as f64 / 1e6,
-            secs
-        );
     }
     Ok(Some(Summary {
         particles: n_global,
