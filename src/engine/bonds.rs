@@ -5,6 +5,7 @@
 //! Newton's third law gives the other end its reaction. A bond's identity is the pair of global
 //! ids of its ends, so its history can follow it to another layout.
 
+use crate::engine::bond_geoms::BondGeoms;
 use crate::engine::cells::{CellGrid, HALF_SHELL};
 use crate::model::attributes::Attributes;
 use crate::model::BondGeom;
@@ -15,7 +16,8 @@ pub struct BondList<H: Attributes> {
     /// Private so that the largest partner index stays known (the force loop relies on it).
     partner: Vec<u32>,
     max_partner: usize,
-    pub geom: Vec<BondGeom>,
+    /// Reference geometry, interned (`bond_geoms`): change a β with `scale_beta`.
+    pub geom: BondGeoms,
     /// Once set, never cleared: a broken bond carries no force again, whatever happens later.
     pub broken: Vec<bool>,
     pub history: Vec<H>,
@@ -37,7 +39,7 @@ pub fn partial_volume(l: f64, horizon: f64, dx: f64) -> f64 {
 pub(crate) struct Families {
     offsets: Vec<u32>,
     partner: Vec<u32>,
-    geom: Vec<BondGeom>,
+    geom: BondGeoms,
     initial: Vec<u32>,
     horizon: f64,
     dx: f64,
@@ -50,7 +52,7 @@ impl Families {
         Families {
             offsets: vec![0],
             partner: Vec::new(),
-            geom: Vec::new(),
+            geom: BondGeoms::new(),
             initial: vec![0; n],
             horizon,
             dx,
@@ -167,7 +169,7 @@ impl<H: Attributes> BondList<H> {
     pub fn assemble(
         offsets: Vec<u32>,
         partner: Vec<u32>,
-        geom: Vec<BondGeom>,
+        geom: BondGeoms,
         initial: Vec<u32>,
     ) -> BondList<H> {
         assert!(
@@ -202,6 +204,17 @@ impl<H: Attributes> BondList<H> {
         &self.offsets
     }
 
+    /// Owners (the families stored).
+    pub fn owners(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Bonds of owner `i`, as a range that holds no borrow (a loop over the bonds can change
+    /// them; collecting `iter()` first would cost 24 bytes per bond).
+    pub fn family(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i] as usize..self.offsets[i + 1] as usize
+    }
+
     /// Partner (store index) of every bond.
     pub fn partners(&self) -> &[u32] {
         &self.partner
@@ -209,7 +222,7 @@ impl<H: Attributes> BondList<H> {
 
     /// Split borrows for the bond loops: (offsets, partners, geometry, broken, history).
     #[allow(clippy::type_complexity)]
-    pub fn parts_mut(&mut self) -> (&[u32], &[u32], &[BondGeom], &mut [bool], &mut [H]) {
+    pub fn parts_mut(&mut self) -> (&[u32], &[u32], &BondGeoms, &mut [bool], &mut [H]) {
         (
             &self.offsets,
             &self.partner,
@@ -263,7 +276,7 @@ impl<H: Attributes> BondList<H> {
 
     /// Bytes held per bond.
     pub fn bytes_per_bond() -> usize {
-        4 + std::mem::size_of::<BondGeom>() + 1 + std::mem::size_of::<H>()
+        4 + BondGeoms::BYTES_PER_BOND + 1 + std::mem::size_of::<H>()
     }
 }
 

@@ -92,14 +92,16 @@ pub fn correct_bonds<H: Attributes>(
     g: impl Fn(usize) -> [f64; 3],
     skip: impl Fn(usize, usize) -> bool,
 ) {
-    let pairs: Vec<(usize, usize, usize)> = bonds.iter().collect();
-    for (i, j, b) in pairs {
-        if skip(i, j) {
-            continue;
+    for i in 0..bonds.owners() {
+        for b in bonds.family(i) {
+            let j = bonds.partners()[b] as usize;
+            if skip(i, j) {
+                continue;
+            }
+            let (a, c) = (x0[i], x0[j]);
+            let xi = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            bonds.geom.scale_beta(b, bond_factor(xi, &g(i), &g(j)));
         }
-        let (a, c) = (x0[i], x0[j]);
-        let xi = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        bonds.geom[b].beta *= bond_factor(xi, &g(i), &g(j));
     }
 }
 

@@ -307,7 +307,7 @@ where
         };
         let mut oi = T::default();
         let range = offsets[i] as usize..offsets[i + 1] as usize;
-        let (partner, geom) = (&partner[range.clone()], &geom[range.clone()]);
+        let (partner, geom) = (&partner[range.clone()], geom.slice(range.clone()));
         let (broken, history) = (&mut broken[range.clone()], &mut history[range]);
         // SAFETY: every partner index is below the particle count (BondList keeps the
         // partner list private and its maximum; checked above), and all per-particle arrays
@@ -340,7 +340,7 @@ where
                     let laws = sides
                         .each_ref()
                         .map(|s| law_of(side_i.material, s.material));
-                    let geoms = at.map(|b| &geom[b]);
+                    let geoms = at.map(|b| geom.get(b));
                     let lanes = (laws.each_ref(), sides.each_ref());
                     if let Some(f) = visit.visit_lanes(lanes.0, &side_i, lanes.1, geoms) {
                         // SAFETY: partners are in bounds, as above.
@@ -361,7 +361,7 @@ where
                         &law_of(side_i.material, sj.material),
                         &side_i,
                         &sj,
-                        &geom[k],
+                        geom.get(k),
                         &mut history[k],
                     );
                     // SAFETY: partners are in bounds, as above.

@@ -4,6 +4,7 @@
 //! calls an [`simulation::Exchange`] it is handed.
 
 pub mod analysis;
+pub mod bond_geoms;
 pub mod bonds;
 pub mod boundary;
 pub mod cells;

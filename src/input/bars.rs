@@ -77,25 +77,27 @@ impl BarBonds {
         if self.factor.is_empty() {
             return;
         }
-        let pairs: Vec<(usize, usize, usize)> = bonds.iter().collect();
-        for (i, j, b) in pairs {
-            if !self.same_bar(gid(i), gid(j)) {
-                continue;
-            }
-            let k = self.bar_of[gid(i) as usize] as usize;
-            bonds.geom[b].beta *= self.factor[k];
-            let prestrain = self.prestrain[k];
-            if prestrain.strain != 0.0 {
-                let (bar, mid) = (
-                    &self.bars[k],
-                    [0, 1, 2].map(|e| 0.5 * (x0[i][e] + x0[j][e])),
-                );
-                // A periodic image can project outside the bar: never a negative distance.
-                let s = along(bar, &mid).clamp(0.0, bar.length());
-                let strain = prestrain.at(s.min(bar.length() - s));
-                let law = model.law(bar.material, bar.material);
-                if let Ok(h) = model.prestrained(&law, strain) {
-                    bonds.history[b] = h;
+        for i in 0..bonds.owners() {
+            for b in bonds.family(i) {
+                let j = bonds.partners()[b] as usize;
+                if !self.same_bar(gid(i), gid(j)) {
+                    continue;
+                }
+                let k = self.bar_of[gid(i) as usize] as usize;
+                bonds.geom.scale_beta(b, self.factor[k]);
+                let prestrain = self.prestrain[k];
+                if prestrain.strain != 0.0 {
+                    let (bar, mid) = (
+                        &self.bars[k],
+                        [0, 1, 2].map(|e| 0.5 * (x0[i][e] + x0[j][e])),
+                    );
+                    // A periodic image can project outside the bar: never a negative distance.
+                    let s = along(bar, &mid).clamp(0.0, bar.length());
+                    let strain = prestrain.at(s.min(bar.length() - s));
+                    let law = model.law(bar.material, bar.material);
+                    if let Ok(h) = model.prestrained(&law, strain) {
+                        bonds.history[b] = h;
+                    }
                 }
             }
         }

@@ -169,7 +169,12 @@ impl<M: Model> Cube<M> {
 
         let mut initial = owned.initial;
         initial.resize(total, 0);
-        let list = BondList::assemble(vec![0; n_owned + 1], Vec::new(), Vec::new(), initial);
+        let list = BondList::assemble(
+            vec![0; n_owned + 1],
+            Vec::new(),
+            Default::default(),
+            initial,
+        );
         self.lost = owned.lost;
         self.install(part, list, plan);
     }

@@ -331,17 +331,18 @@ impl Snapshot {
         let gid = &sim.particles.gid;
         let key = |i: usize, j: usize| (gid[i].min(gid[j]), gid[i].max(gid[j]));
         let b = &mut sim.bonds;
-        let bonds: Vec<(usize, usize, usize)> = b.iter().collect();
-        for (i, j, k) in bonds {
-            let pair = key(i, j);
-            if self.broken.binary_search(&pair).is_ok() {
-                b.broken[k] = true;
-            }
-            if lb > 0 {
-                if let Ok(at) = self.history_pairs.binary_search(&pair) {
-                    b.history[k]
-                        .as_mut_slice()
-                        .copy_from_slice(&self.history[at * lb..(at + 1) * lb]);
+        for i in 0..b.owners() {
+            for k in b.family(i) {
+                let pair = key(i, b.partners()[k] as usize);
+                if self.broken.binary_search(&pair).is_ok() {
+                    b.broken[k] = true;
+                }
+                if lb > 0 {
+                    if let Ok(at) = self.history_pairs.binary_search(&pair) {
+                        b.history[k]
+                            .as_mut_slice()
+                            .copy_from_slice(&self.history[at * lb..(at + 1) * lb]);
+                    }
                 }
             }
         }

@@ -348,7 +348,7 @@ pub fn assemble_tangent<M: Model>(cube: &mut Cube<M>) -> Result<Tangent, String>
     // Reach of a particle's force: the longest bond, twice over a state pass.
     let sim = &cube.sim;
     let (mut longest, mut shortest) = (0.0f64, f64::INFINITY);
-    for g in &sim.bonds.geom {
+    for g in sim.bonds.geom.iter() {
         longest = longest.max(g.length);
         shortest = shortest.min(g.length);
     }

@@ -85,7 +85,7 @@ pub fn hand_pmb_pass(
     volume: &[f64],
     offsets: &[u32],
     partner: &[u32],
-    geom: &[crate::model::BondGeom],
+    geom: &crate::engine::bond_geoms::BondGeoms,
     broken: &mut [bool],
     force: &mut [[f64; 3]],
     c: f64,
