@@ -74,16 +74,33 @@ impl BarBonds {
         x0: &[[f64; 3]],
         gid: impl Fn(usize) -> u32,
     ) {
+        if self.bar_of.is_empty() {
+            return;
+        }
+        self.apply_by_store(model, bonds, x0, |l| self.bar_of[gid(l) as usize]);
+    }
+
+    /// [`BarBonds::apply`] to a store whose particle `l` belongs to bar `bar(l)` ([`NOT_A_BAR`]
+    /// for a lattice particle): a procCube built on its own knows its particles' bars, not the
+    /// scene's.
+    pub fn apply_by_store<M: Model>(
+        &self,
+        model: &M,
+        bonds: &mut BondList<M::Bond>,
+        x0: &[[f64; 3]],
+        bar: impl Fn(usize) -> u32,
+    ) {
         if self.factor.is_empty() {
             return;
         }
         for i in 0..bonds.owners() {
             for b in bonds.family(i) {
                 let j = bonds.partners()[b] as usize;
-                if !self.same_bar(gid(i), gid(j)) {
+                let k = bar(i);
+                if k == NOT_A_BAR || k != bar(j) {
                     continue;
                 }
-                let k = self.bar_of[gid(i) as usize] as usize;
+                let k = k as usize;
                 bonds.geom.scale_beta(b, self.factor[k]);
                 let prestrain = self.prestrain[k];
                 if prestrain.strain != 0.0 {
@@ -112,20 +129,32 @@ fn along(bar: &Bar, x: &[f64; 3]) -> f64 {
         .sum()
 }
 
+/// How a store takes part in the calibration: the bar of each store particle, and the
+/// completion of sums that other procCubes share.
+pub struct Share<'a> {
+    /// Bar of store particle `l` ([`NOT_A_BAR`] for a lattice particle).
+    pub bar: &'a dyn Fn(usize) -> u32,
+    /// Adds what ghosts received into their owners (a procCube's reverse messages; nothing for
+    /// the whole scene).
+    pub complete: &'a mut dyn FnMut(&mut [f64]),
+    /// Sums values over every procCube (nothing for the whole scene).
+    pub sum: &'a mut dyn FnMut(&mut [f64]),
+}
+
 /// γ of each bar (1 for a bar without own bonds): the factor that makes a bar of Young's
-/// modulus `modulus[b]` carry E·A·ε. `bar_of` is by global id; the store holds whole families
-/// with the bonds' β already final otherwise (partial volume, surface correction).
+/// modulus `modulus[b]` carry E·A·ε. The store holds the families of its owned particles with
+/// the bonds' β already final otherwise (partial volume, surface correction).
 pub fn calibrate<M: Model>(
     model: &M,
     p: &mut Particles<M>,
     bonds: &BondList<M::Bond>,
     bars: &[Bar],
     modulus: &[f64],
-    bar_of: &[u32],
+    share: Share,
     horizon: f64,
 ) -> Vec<f64> {
     let n = p.len();
-    let bar = |i: usize| bar_of[p.gid[i] as usize];
+    let bar = share.bar;
     let axis = |b: &Bar| {
         let l = b.length();
         [0, 1, 2].map(|k| (b.to[k] - b.from[k]) / l)
@@ -142,10 +171,11 @@ pub fn calibrate<M: Model>(
             a[k] = p.x0[i][k] + PROBE_STRAIN * s * t[k];
         }
     }
-    let w = crate::engine::correction::particle_energies(model, p, bonds, |i, j| {
+    let mut w = crate::engine::correction::particle_energies(model, p, bonds, |i, j| {
         bar(i) != NOT_A_BAR && bar(i) == bar(j)
     });
     p.alter.clone_from(&saved);
+    (share.complete)(&mut w);
 
     // Per bar: (discrete, continuum) energy over its interior particles and over all of them.
     let mut interior = vec![(0.0, 0.0); bars.len()];
@@ -165,6 +195,17 @@ pub fn calibrate<M: Model>(
         sums.0 += wi;
         sums.1 += continuum;
     }
+    let mut sums: Vec<f64> = interior
+        .iter()
+        .chain(&whole)
+        .flat_map(|&(d, c)| [d, c])
+        .collect();
+    (share.sum)(&mut sums);
+    let pair = |k: usize| (sums[2 * k], sums[2 * k + 1]);
+    let (interior, whole): (Vec<_>, Vec<_>) = (
+        (0..bars.len()).map(pair).collect(),
+        (bars.len()..2 * bars.len()).map(pair).collect(),
+    );
     interior
         .iter()
         .zip(&whole)

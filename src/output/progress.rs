@@ -5,6 +5,8 @@ use std::time::Instant;
 
 /// A progress bar with ETA on a terminal; a plain line every 10% otherwise.
 pub struct Progress {
+    /// The step the run started from (a restart's checkpoint step, else 0).
+    first: u64,
     total: u64,
     start: Instant,
     last: Instant,
@@ -14,14 +16,15 @@ pub struct Progress {
 }
 
 impl Progress {
-    pub fn new(total: u64, enabled: bool) -> Progress {
+    pub fn new(first: u64, total: u64, enabled: bool) -> Progress {
         Progress {
+            first,
             total: total.max(1),
             start: Instant::now(),
             last: Instant::now(),
             tty: std::io::stderr().is_terminal(),
             enabled,
-            next_tenth: 1,
+            next_tenth: 1 + first * 10 / total.max(1),
         }
     }
 
@@ -31,8 +34,10 @@ impl Progress {
         }
         let elapsed = self.start.elapsed().as_secs_f64();
         let frac = done as f64 / self.total as f64;
-        let eta = if done > 0 {
-            elapsed * (1.0 - frac) / frac
+        // From the steps this run has made: a restart's earlier steps took no time here.
+        let made = done.saturating_sub(self.first);
+        let eta = if made > 0 {
+            elapsed * self.total.saturating_sub(done) as f64 / made as f64
         } else {
             0.0
         };

@@ -32,7 +32,6 @@ use std::time::Instant;
 pub fn unsupported(scene: &Scene) -> Option<&'static str> {
     let checks = [
         (scene.pair.is_some(), "a [pair] law"),
-        (!scene.bars.is_empty(), "[[bar]]s"),
         (scene.surface_correction, "the surface correction"),
         (scene.velocity.is_some(), "[velocity]"),
         (scene.thermostat.is_some(), "a [thermostat]"),
@@ -205,11 +204,14 @@ pub fn build_part<M: Model>(
         found.iter().map(|s| s.volume).collect(),
         found.iter().map(|s| s.material).collect(),
     );
+    let bar_of: Vec<u32> = found.iter().map(|s| s.bar).collect();
     drop(found);
     p.n_owned = plan.n_owned;
-    let bonds: BondList<M::Bond> =
+    let mut bonds: BondList<M::Bond> =
         plan.find_bonds(&p.x0, scene.horizon, scene.spacing, scene.partial_volume);
     let mut wall = WallExchange::new(plan.stages.clone(), transport);
+    bars(&model, &mut p, &mut bonds, scene, &bar_of, &mut wall)?;
+    drop(bar_of);
     let own_step = owned_stable_step(&model, &mut p, &bonds, &mut wall);
     let team = RefCell::new(Team::new(wall.transport()));
     coincident(&p, &bonds, scene, &team)?;
@@ -296,6 +298,62 @@ fn coincident<M: Model, T: Transport>(
     ))
 }
 
+/// The bars' calibration and prestrains (`input/bars.rs`) on a procCube built on its own: a
+/// bar particle's energy is completed over the walls (its bonds held by neighbours), and each
+/// bar's sums over every procCube, so γ is the whole-scene setup's to round-off. `bar_of` is
+/// the bar of each store particle.
+fn bars<M: Model>(
+    model: &M,
+    q: &mut Particles<M>,
+    bonds: &mut BondList<M::Bond>,
+    scene: &Scene,
+    bar_of: &[u32],
+    wall: &mut WallExchange,
+) -> Result<(), DeckError> {
+    if scene.bars.is_empty() {
+        return Ok(());
+    }
+    let base = whole_fixed(model, q, bonds, wall);
+    let wall = RefCell::new(wall);
+    let bar = |l: usize| bar_of[l];
+    let share = crate::input::bars::Share {
+        bar: &bar,
+        complete: &mut |w: &mut [f64]| wall.borrow_mut().reverse(w, |a, b| *a += *b),
+        sum: &mut |v: &mut [f64]| Team::new(wall.borrow_mut().transport()).reduce(v, Reduce::Sum),
+    };
+    let factor = crate::input::setup::bar_factors(model, q, bonds, scene, share);
+    q.fixed = base;
+    let applied = crate::input::bars::BarBonds {
+        bar_of: Vec::new(),
+        factor: factor?,
+        bars: scene.geometry_bars(),
+        prestrain: scene.bar_prestrain(),
+    };
+    applied.apply_by_store(model, bonds, &q.x0, bar);
+    Ok(())
+}
+
+/// The fixed values bonds make (the weighted volume) made whole over the walls, for a pass that
+/// needs them before `Cube::start` does; returns the values to put back afterwards.
+fn whole_fixed<M: Model>(
+    model: &M,
+    q: &mut Particles<M>,
+    bonds: &BondList<M::Bond>,
+    wall: &mut WallExchange,
+) -> Vec<M::Fixed> {
+    use crate::model::attributes::add_assign;
+    let base = q.fixed.clone();
+    if M::FIXED_FROM_BONDS {
+        let mut sums = crate::engine::forces::bond_fixed_sums(model, q, bonds);
+        wall.reverse(&mut sums, add_assign);
+        for (f, s) in q.fixed.iter_mut().zip(&sums).take(q.n_owned) {
+            add_assign(f, s);
+        }
+        wall.forward(&mut q.fixed, false);
+    }
+    base
+}
+
 /// The Silling–Askari bound of the owned particles: each particle's stiffness summed over
 /// the bonds of every procCube (the wall's reverse messages), after the fixed values bonds make
 /// (the weighted volume) are whole; the smallest step and its particle's global id.
@@ -307,15 +365,7 @@ fn owned_stable_step<M: Model>(
 ) -> (f64, u32) {
     use crate::model::attributes::add_assign;
     // `Cube::start` makes the fixed values whole again; these are for the bound only.
-    let base = q.fixed.clone();
-    if M::FIXED_FROM_BONDS {
-        let mut sums = crate::engine::forces::bond_fixed_sums(model, q, bonds);
-        wall.reverse(&mut sums, add_assign);
-        for (f, s) in q.fixed.iter_mut().zip(&sums).take(q.n_owned) {
-            add_assign(f, s);
-        }
-        wall.forward(&mut q.fixed, false);
-    }
+    let base = whole_fixed(model, q, bonds, wall);
     let mut sums = stiffness_sums(model, q, bonds);
     wall.reverse(&mut sums, add_assign);
     let n2 = second_order::<M>();

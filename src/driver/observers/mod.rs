@@ -155,7 +155,11 @@ pub(crate) fn observers<'a, M: Model>(
             Err(e) => watch.error = Some(e),
         }
     }
-    let progress = Progress::new(plan.steps, root && plan.progress && !plan.quiet);
+    let progress = Progress::new(
+        plan.first_step,
+        plan.steps,
+        root && plan.progress && !plan.quiet,
+    );
     let mut list: Vec<Box<dyn Observer<M> + 'a>> = vec![
         Box::new(stops::BrokenBonds::new(plan)),
         Box::new(stops::BlowUp::new(plan)),

@@ -279,6 +279,31 @@ fn bar_bonds<M: Model>(
     if scene.bars.is_empty() {
         return Ok(BarBonds::default());
     }
+    let gid = particles.gid.clone();
+    let bar = |l: usize| bar_of[gid[l] as usize];
+    let share = crate::input::bars::Share {
+        bar: &bar,
+        complete: &mut |_| {},
+        sum: &mut |_| {},
+    };
+    let factor = bar_factors(model, particles, bonds, scene, share)?;
+    Ok(BarBonds {
+        bar_of,
+        factor,
+        bars: scene.geometry_bars(),
+        prestrain: scene.bar_prestrain(),
+    })
+}
+
+/// Each bar's calibration factor γ (1 for state-based models), after checking that the model
+/// accepts each bar's prestrain; `share` says how the store's particles take part.
+pub(crate) fn bar_factors<M: Model>(
+    model: &M,
+    particles: &mut Particles<M>,
+    bonds: &BondList<M::Bond>,
+    scene: &Scene,
+    share: crate::input::bars::Share,
+) -> Result<Vec<f64>, DeckError> {
     let bars = scene.geometry_bars();
     let mut modulus = Vec::with_capacity(bars.len());
     for b in &bars {
@@ -297,7 +322,7 @@ fn bar_bonds<M: Model>(
             bonds,
             &bars,
             &modulus,
-            &bar_of,
+            share,
             scene.horizon,
         )
     } else {
@@ -311,12 +336,7 @@ fn bar_bonds<M: Model>(
                 .map_err(|m| scene.error(Some(b.line), format!("bar {k}: {m}")))?;
         }
     }
-    Ok(BarBonds {
-        bar_of,
-        factor,
-        bars,
-        prestrain: scene.bar_prestrain(),
-    })
+    Ok(factor)
 }
 
 /// Cells of side ≥ the horizon and ≥ the pair law's `reach` (cutoff + skin) over the scene. A
