@@ -14,7 +14,7 @@ use crate::engine::bonds::BondList;
 use crate::engine::cells::Domain;
 use crate::engine::particles::Particles;
 use crate::engine::simulation::{stiffness_sums, Simulation};
-use crate::input::deck::{CriticalStep, DeckError, Scene, SolverSpec};
+use crate::input::deck::{DeckError, Scene};
 use crate::input::geometry::{SceneSites, Site};
 use crate::input::setup::place::{self, Scope};
 use crate::model::attributes::Attributes;
@@ -30,24 +30,7 @@ use std::time::Instant;
 /// What a deck uses that per-rank setup does not build yet (the whole-scene setup does), if
 /// anything.
 pub fn unsupported(scene: &Scene) -> Option<&'static str> {
-    let checks = [
-        (scene.pair.is_some(), "a [pair] law"),
-        (scene.surface_correction, "the surface correction"),
-        (scene.velocity.is_some(), "[velocity]"),
-        (scene.thermostat.is_some(), "a [thermostat]"),
-        (scene.deform.is_some(), "[deform]"),
-        (scene.time.static_until.is_some(), "a static start"),
-        (
-            scene.time.critical_step == CriticalStep::Measured,
-            "a measured critical step",
-        ),
-        (
-            !matches!(scene.solver.item, SolverSpec::Explicit),
-            "a quasi-static [solver]",
-        ),
-        (scene.parallel.shuffle_every > 0, "shuffles"),
-    ];
-    checks.iter().find(|c| c.0).map(|c| c.1)
+    scene.built_whole_by()
 }
 
 /// One procCube built on its own, with what the run needs to know of the whole scene.

@@ -445,6 +445,29 @@ impl Scene {
         self.bars.iter().map(|b| b.bar.clone()).collect()
     }
 
+    /// What this deck uses that setup per rank (`parallel::part`) does not build yet, so that
+    /// every MPI rank builds the whole scene, if anything.
+    pub fn built_whole_by(&self) -> Option<&'static str> {
+        let checks = [
+            (self.pair.is_some(), "a [pair] law"),
+            (self.surface_correction, "the surface correction"),
+            (self.velocity.is_some(), "[velocity]"),
+            (self.thermostat.is_some(), "a [thermostat]"),
+            (self.deform.is_some(), "[deform]"),
+            (self.time.static_until.is_some(), "a static start"),
+            (
+                self.time.critical_step == CriticalStep::Measured,
+                "a measured critical step",
+            ),
+            (
+                !matches!(self.solver.item, SolverSpec::Explicit),
+                "a quasi-static [solver]",
+            ),
+            (self.parallel.shuffle_every > 0, "shuffles"),
+        ];
+        checks.iter().find(|c| c.0).map(|c| c.1)
+    }
+
     /// Each bar's prestrain, in bar order.
     pub fn bar_prestrain(&self) -> Vec<Prestrain> {
         self.bars.iter().map(|b| b.prestrain).collect()

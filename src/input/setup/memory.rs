@@ -115,8 +115,11 @@ pub fn guard<M: Model>(scene: &Scene, reach: f64) -> Result<Estimate, DeckError>
         // The builder reports what is wrong with the geometry.
         return Ok(Estimate::default());
     };
-    let remedy = "; more MPI ranks do not help, as every rank of this deck builds the whole scene (docs/wall_method.md, setup per rank)";
-    refuse_beyond(scene, e, 1.0, remedy)
+    let remedy = match scene.built_whole_by() {
+        Some(what) => format!("; more MPI ranks do not help, as every rank of this deck builds the whole scene ({what} is not built per rank yet; docs/wall_method.md, setup per rank)"),
+        None => ", or MPI ranks on more machines: under mpirun each rank builds only its procCube (docs/wall_method.md, setup per rank)".to_string(),
+    };
+    refuse_beyond(scene, e, 1.0, &remedy)
 }
 
 /// Peak resident memory of a rank that builds only its procCube (`parallel::part`), over its
