@@ -1,6 +1,6 @@
 //! `pdq run` with setup per rank (`parallel::part`): each worker builds only its procCube from
 //! the geometry, so that its memory is its share of the scene, and then steps it as any run.
-//! Used under `mpirun` when the deck has nothing `part::unsupported` names (the whole-scene
+//! Used under `mpirun` when the deck has nothing `Scene::built_whole_by` names (the whole-scene
 //! setup builds those); `run_on_threads` runs it on threads (tests).
 //!
 //! Frames and checkpoints are written in parts, and a restart reads its procCube's share of a
@@ -21,7 +21,7 @@ use crate::parallel::part::{self, Parts};
 /// Whether `pdq run` builds this deck per rank under `mpirun`.
 pub fn per_rank(scene: &Scene, opts: &RunOptions) -> bool {
     let _ = opts;
-    part::unsupported(scene).is_none()
+    scene.built_whole_by().is_none()
 }
 
 /// Runs procCube `rank` of `ranks` over `transport`, built on its own; the root's summary.
@@ -124,7 +124,7 @@ fn resume_part<M: Model>(
     local.sort_unstable();
     let keep = |g: u32| local.binary_search(&g).is_ok();
     let (path, c) = crate::output::checkpoint::resolve_some(from, Some(&keep))?;
-    // Decks with a static start are built whole (`part::unsupported`): runs start at t = 0.
+    // Decks with a static start are built whole (`Scene::built_whole_by`): runs start at t = 0.
     super::run::check_resume(&c, &path, scene, (0.0, steps), &cube.sim)?;
     c.state.restore_particles(&mut cube.sim);
     Ok(c)

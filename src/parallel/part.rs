@@ -27,12 +27,6 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 use std::time::Instant;
 
-/// What a deck uses that per-rank setup does not build yet (the whole-scene setup does), if
-/// anything.
-pub fn unsupported(scene: &Scene) -> Option<&'static str> {
-    scene.built_whole_by()
-}
-
 /// One procCube built on its own, with what the run needs to know of the whole scene.
 pub struct PartSetup<M: Model> {
     pub cube: Cube<M>,
@@ -221,7 +215,7 @@ pub fn build_part<M: Model>(
     for c in &sim.constraints {
         c.set_velocity(&mut sim.particles, 0.0, dt);
     }
-    // Shared only by shuffles, which a per-rank scene does not make (`unsupported`).
+    // Shared only by shuffles, which a per-rank scene does not make (`Scene::built_whole_by`).
     let everywhere = Everywhere {
         constraints: Vec::new(),
         loads: Vec::new(),
