@@ -178,6 +178,16 @@ fn run_with_history(
     procs: [usize; 3],
     walls: Walls,
 ) -> (Summary, Vec<String>, Vec<Vec<f64>>) {
+    history_run(text, procs, walls, false)
+}
+
+/// [`run_with_history`], set up per procCube (`parallel::part`) where `per_rank`.
+fn history_run(
+    text: &str,
+    procs: [usize; 3],
+    walls: Walls,
+    per_rank: bool,
+) -> (Summary, Vec<String>, Vec<Vec<f64>>) {
     let scene = deck::parse(text, "t.toml", "t").unwrap();
     static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!(
@@ -189,17 +199,20 @@ fn run_with_history(
         procs[2],
         walls.name()
     ));
-    let s = run(
-        &scene,
-        &RunOptions {
-            output: Some(dir.clone()),
-            quiet: true,
-            threads: Some(procs.iter().product()),
-            procs: Some(Procs::Given(procs)),
-            walls: Some(walls),
-            ..Default::default()
-        },
-    )
+    let n = procs.iter().product();
+    let options = RunOptions {
+        output: Some(dir.clone()),
+        quiet: true,
+        threads: Some(n),
+        procs: Some(Procs::Given(procs)),
+        walls: Some(walls),
+        ..Default::default()
+    };
+    let s = if per_rank {
+        pdq::driver::run_part::run_on_threads(&scene, &options, n)
+    } else {
+        run(&scene, &options)
+    }
     .unwrap();
     let text = std::fs::read_to_string(dir.join("history.csv")).unwrap();
     let mut lines = text.lines();
@@ -494,59 +507,42 @@ fn shuffled_runs_match_unshuffled_ones() {
 }
 
 #[test]
+fn a_particle_further_than_the_next_proc_cube_is_an_error() {
+    // One shuffle after 400 steps: the block's rear has crossed two of the four procCubes,
+    // which migration (to neighbours only) must refuse by name rather than lose.
+    let late = flying_block("[parallel]\nshuffle_every = 400\n");
+    let scene = deck::parse(&late, "t.toml", "t").unwrap();
+    let dir = std::env::temp_dir().join(format!("pdq-far-jump-{}", std::process::id()));
+    let options = RunOptions {
+        output: Some(dir.clone()),
+        quiet: true,
+        threads: Some(4),
+        procs: Some(Procs::Given([4, 1, 1])),
+        walls: Some(Walls::Whole),
+        ..Default::default()
+    };
+    let Err(e) = run(&scene, &options) else {
+        panic!("the jump must be refused");
+    };
+    let _ = std::fs::remove_dir_all(dir);
+    assert!(
+        e.contains("particle ")
+            && e.contains("further than the next procCube")
+            && e.contains("shuffle_every")
+            && e.contains("step 400"),
+        "{e}"
+    );
+}
+
+#[test]
 fn shuffles_keep_reactions_loads_and_damage() {
     // A notched bar carried along x at 80 m/s by two grips that pull it apart at 4 m/s, with a
     // total-force load and a probe: particles cross procCube faces, the grips keep reacting,
     // and the history must not notice the shuffles.
     let deck = |parallel: &str| {
         format!(
-            r#"units = "SI"
-[model]
-name = "pmb"
-horizon = "3.015 mm"
-[lattice]
-spacing = "1 mm"
-[materials.rock]
-density = "2200 kg/m^3"
-bulk_modulus = "14.9 GPa"
-critical_stretch = 0.0005
-[[geometry]]
-shape = "box"
-material = "rock"
-min = "0 0 0 mm"
-max = "30 10 10 mm"
-[[geometry]]
-op = "subtract"
-shape = "box"
-min = "14.5 0 5 mm"
-max = "15.5 10 10 mm"
-[time]
-steps = 500
-[[initial]]
-region = {{ shape = "box", min = "0 0 0 mm", max = "30 10 10 mm" }}
-velocity = "80 0 0 m/s"
-[[boundary]]
-name = "left"
-region = {{ shape = "slab", axis = "x", from = "0 mm", to = "3 mm" }}
-velocity = "80 0 0 m/s"
-[[boundary]]
-name = "right"
-region = {{ shape = "slab", axis = "x", from = "27 mm", to = "30 mm" }}
-velocity = "80.2 0.05 0 m/s"
-components = ["x", "y"]
-[[load]]
-name = "push"
-region = {{ shape = "slab", axis = "z", from = "9 mm", to = "10 mm" }}
-total_force = "0 0 -50 N"
-[[probe]]
-name = "tip"
-at = "30 5 5 mm"
-[output]
-progress = false
-history_every = 50
-[parallel]
-{parallel}
-"#
+            "{}[parallel]\n{parallel}\n",
+            include_str!("decks/carried_bar.toml")
         )
     };
     let plain = deck("skin = 0.25");
@@ -572,17 +568,25 @@ history_every = 50
             d.1
         );
     }
-    assert_eq!(rows_a.len(), rows_b.len());
-    for (ra, rb) in rows_a.iter().zip(&rows_b) {
-        for (c, name) in header.iter().enumerate() {
-            let scale = rows_a.iter().map(|r| r[c].abs()).fold(1e-30, f64::max);
-            assert!(
-                (ra[c] - rb[c]).abs() <= 1e-9 * scale + 1e-12,
-                "step {}: {name} {} vs {}",
-                ra[0],
-                ra[c],
-                rb[c]
-            );
+    // Set up per procCube, each particle's places in the grips, the load and the probe travel
+    // with it: no procCube holds the whole scene's lists.
+    let (c, _, rows_c) = history_run(&shuffled, [2, 2, 1], Walls::Whole, true);
+    assert_eq!(b.shuffles, c.shuffles);
+    assert_eq!(a.broken_pairs, c.broken_pairs);
+    assert!(max_relative_difference(&a.positions, &c.positions) <= 1e-12);
+    for rows in [rows_b, rows_c] {
+        assert_eq!(rows_a.len(), rows.len());
+        for (ra, rb) in rows_a.iter().zip(&rows) {
+            for (c, name) in header.iter().enumerate() {
+                let scale = rows_a.iter().map(|r| r[c].abs()).fold(1e-30, f64::max);
+                assert!(
+                    (ra[c] - rb[c]).abs() <= 1e-9 * scale + 1e-12,
+                    "step {}: {name} {} vs {}",
+                    ra[0],
+                    ra[c],
+                    rb[c]
+                );
+            }
         }
     }
 }

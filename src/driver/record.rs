@@ -475,11 +475,10 @@ pub(crate) fn finish<M: Model>(
         }
     );
     if cube.sim.pairs.is_some() {
-        let [migrated, shuffled] = cube.rebuilds;
         let _ = writeln!(
             timing,
-            "neighbour lists: {} rebuilds ({migrated} by migration, {shuffled} by shuffle)",
-            migrated + shuffled
+            "neighbour lists: {} rebuilds, by migration to neighbouring procCubes",
+            cube.rebuilds
         );
     }
     if balance.len() > 1 {

@@ -30,34 +30,27 @@ pub struct Cube<M: Model> {
     pub probes: Vec<(usize, usize)>,
     /// Global particle count of the scene.
     pub global_particles: usize,
-    /// The whole scene's boundary conditions, loads and probes by global id, so that a shuffle
-    /// can hand each procCube its share again.
-    pub(crate) everywhere: Everywhere,
-    /// Bonds dropped from the bond list once broken (by a shuffle), per owned particle.
+    /// Bonds dropped from the bond list once broken (by a migration), per owned particle.
     pub lost: Vec<u32>,
     /// Those bonds as (smaller, larger) global ids, kept by the owner of the smaller.
     pub dropped: Vec<(u32, u32)>,
-    /// Neighbour-list rebuilds that moved particles by migration, and by a shuffle (the same
-    /// on every worker: the choice is collective).
-    pub rebuilds: [u64; 2],
+    /// Neighbour-list rebuilds, each a migration (the same on every worker: the choice is
+    /// collective).
+    pub rebuilds: u64,
     /// `[deform]`: the periodic box changing with time (set by the step loop).
     pub deform: Option<crate::parallel::deform::Deform>,
 }
 
-/// Boundary conditions, loads and probes of the whole scene, by global id.
+/// Boundary conditions, loads and probes of the whole scene, by global id, while each procCube
+/// takes its share at the start (later, each particle's places travel with it).
 #[derive(Clone, Debug)]
-pub(crate) struct Everywhere {
+struct Everywhere {
     pub constraints: Vec<(Constraint, Vec<u32>)>,
     pub loads: Vec<(Load, Vec<u32>)>,
     pub probes: Vec<u32>,
 }
 
 impl Everywhere {
-    /// Whether the scene has no boundary conditions, loads or probes at all.
-    pub fn is_empty(&self) -> bool {
-        self.constraints.is_empty() && self.loads.is_empty() && self.probes.is_empty()
-    }
-
     fn of<M: Model>(setup: &Setup<M>) -> Everywhere {
         let gid = &setup.sim.particles.gid;
         let by_gid = |list: &[u32]| list.iter().map(|&i| gid[i as usize]).collect();
@@ -190,8 +183,7 @@ pub fn build_cube<M: Model>(
     for l in 0..plan.n_owned {
         local[g.gid[idx(l)] as usize] = l as u32;
     }
-    let everywhere = Everywhere::of(setup);
-    let (constraints, loads, probes) = everywhere.share(&local);
+    let (constraints, loads, probes) = Everywhere::of(setup).share(&local);
     let mut sim = Simulation::new(setup.sim.model.clone(), p, bonds, setup.sim.dt);
     sim.integrator = setup.sim.integrator;
     sim.constraints = constraints;
@@ -207,9 +199,8 @@ pub fn build_cube<M: Model>(
         layout: layout.clone(),
         probes,
         global_particles: g.len(),
-        everywhere,
         dropped: Vec::new(),
-        rebuilds: [0; 2],
+        rebuilds: 0,
         deform: None,
     }
 }

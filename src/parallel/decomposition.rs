@@ -45,7 +45,7 @@ impl Layout {
         self.procs.iter().product()
     }
 
-    fn coords(&self, k: usize) -> [usize; 3] {
+    pub(crate) fn coords(&self, k: usize) -> [usize; 3] {
         let p = self.procs;
         [k % p[0], (k / p[0]) % p[1], k / (p[0] * p[1])]
     }

@@ -4,6 +4,7 @@
 //! the procCube itself ([`cube`]), which steps with its wall exchange.
 
 pub mod balance;
+mod carried;
 pub mod comm;
 #[cfg(feature = "mpi")]
 pub mod comm_mpi;

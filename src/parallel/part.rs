@@ -20,7 +20,7 @@ use crate::input::setup::place::{self, Scope};
 use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model};
 use crate::parallel::comm::{Reduce, Team, Transport};
-use crate::parallel::cube::{Cube, Everywhere};
+use crate::parallel::cube::Cube;
 use crate::parallel::decomposition::{cell_plans, particle_plan, CellPlan, Layout, Procs, Walls};
 use crate::parallel::wall::WallExchange;
 use std::cell::RefCell;
@@ -215,12 +215,6 @@ pub fn build_part<M: Model>(
     for c in &sim.constraints {
         c.set_velocity(&mut sim.particles, 0.0, dt);
     }
-    // Shared only by shuffles, which a per-rank scene does not make (`Scene::built_whole_by`).
-    let everywhere = Everywhere {
-        constraints: Vec::new(),
-        loads: Vec::new(),
-        probes: Vec::new(),
-    };
     let n_owned = plan.n_owned;
     let cube = Cube {
         wall,
@@ -230,9 +224,8 @@ pub fn build_part<M: Model>(
         layout: layout.clone(),
         probes,
         global_particles: sites.len(),
-        everywhere,
         dropped: Vec::new(),
-        rebuilds: [0; 2],
+        rebuilds: 0,
         deform: None,
     };
     Ok(PartSetup {

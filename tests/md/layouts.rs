@@ -32,7 +32,7 @@ fn the_lj_melt_is_the_same_on_1_2_and_4_threads() {
         let d = max_distance(&reference, &final_positions(&dir), period);
         eprintln!("{threads} threads {procs:?}: positions within {d:.2e} of one thread's");
         assert!(d < 1e-9, "{procs:?}: positions differ by {d:e}");
-        // Every rebuild moved atoms to their new procCubes by migration, not by a shuffle.
+        // Atoms did change procCube: the lists were rebuilt, each by a migration.
         let timing = std::fs::read_to_string(dir.join("timing.txt")).unwrap();
         let line = timing
             .lines()
@@ -43,7 +43,7 @@ fn the_lj_melt_is_the_same_on_1_2_and_4_threads() {
             .filter_map(|w| w.parse().ok())
             .collect();
         assert!(
-            numbers.len() == 3 && numbers[1] > 0 && numbers[1] == numbers[0],
+            numbers.len() == 1 && numbers[0] > 0 && line.contains("by migration"),
             "{procs:?}: {line}"
         );
         let other = std::fs::read_to_string(dir.join("history.csv")).unwrap();
@@ -84,7 +84,7 @@ fn the_lj_melt_with_free_faces_is_the_same_cut_across_them() {
         assert!(d < 1e-9, "{procs:?}: positions differ by {d:e}");
         let timing = std::fs::read_to_string(dir.join("timing.txt")).unwrap();
         assert!(
-            timing.contains("by migration") && !timing.contains("(0 by migration"),
+            timing.contains("by migration") && !timing.contains("lists: 0 rebuilds"),
             "{procs:?}: no rebuild by migration:\n{timing}"
         );
     }

@@ -463,7 +463,6 @@ impl Scene {
                 !matches!(self.solver.item, SolverSpec::Explicit),
                 "a quasi-static [solver]",
             ),
-            (self.parallel.shuffle_every > 0, "shuffles"),
         ];
         checks.iter().find(|c| c.0).map(|c| c.1)
     }
