@@ -27,7 +27,8 @@ impl BondGeoms {
         BondGeoms::default()
     }
 
-    fn intern(&mut self, g: BondGeom) -> u32 {
+    /// The table position of `g`, added if new.
+    pub(crate) fn intern(&mut self, g: BondGeom) -> u32 {
         let key = [g.length.to_bits(), g.beta.to_bits()];
         if let Some(&at) = self.lookup.get(&key) {
             return at;
@@ -46,6 +47,28 @@ impl BondGeoms {
     pub fn push(&mut self, g: BondGeom) {
         let at = self.intern(g);
         self.index.push(at);
+    }
+
+    /// Appends a bond by its table position, as [`BondGeoms::position`] or
+    /// [`BondGeoms::intern`] gave it.
+    pub(crate) fn push_position(&mut self, at: u32) {
+        assert!(
+            (at as usize) < self.table.len(),
+            "bond geometry position out of the table"
+        );
+        self.index.push(at);
+    }
+
+    /// The table position of bond `k`'s geometry.
+    pub(crate) fn position(&self, k: usize) -> u32 {
+        self.index[k]
+    }
+
+    /// The table alone, with no bonds: a migration keeps each staying bond's position in it
+    /// and interns the arriving ones.
+    pub(crate) fn table_only(mut self) -> BondGeoms {
+        self.index = Vec::new();
+        self
     }
 
     pub fn len(&self) -> usize {

@@ -195,6 +195,17 @@ impl<H: Attributes> BondList<H> {
         }
     }
 
+    /// A list of no bonds and no particles.
+    pub(crate) fn empty() -> BondList<H> {
+        BondList::assemble(vec![0], Vec::new(), BondGeoms::new(), Vec::new())
+    }
+
+    /// The geometry table alone, the rest of the list freed (a migration keeps the bonds
+    /// that stay as compact records and builds a new list from them).
+    pub(crate) fn into_geom_table(self) -> BondGeoms {
+        self.geom.table_only()
+    }
+
     pub fn len(&self) -> usize {
         self.partner.len()
     }

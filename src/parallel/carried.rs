@@ -6,6 +6,7 @@
 //! needs the whole scene's lists. The records are built before the particles move, while every
 //! bond's ends are both held, and placed once the ghosts have arrived.
 
+use crate::engine::bond_geoms::BondGeoms;
 use crate::engine::bonds::BondList;
 use crate::engine::cells::HALF_SHELL;
 use crate::model::attributes::Attributes;
@@ -78,12 +79,42 @@ impl Travellers for Letters {
     }
 }
 
+/// A bond that stays on this procCube through a migration: by its ends' global ids and the
+/// cell offset from a's cell to b's until the particles have settled, then by their new local
+/// indices. Most bonds stay, and these records are a migration's peak memory: 16 bytes for a
+/// bond without history, where a letter takes 88.
+pub(crate) struct KeptBond<H> {
+    a: u32,
+    b: u32,
+    /// Its geometry's position in the table of [`Kept::geoms`].
+    geom: u32,
+    /// The cell offset from a's cell to b's ([`pack_offset`]).
+    offset: u8,
+    history: H,
+}
+
+/// The bonds that stay, and the old list's geometry table their positions point into.
+pub(crate) struct Kept<H> {
+    bonds: Vec<KeptBond<H>>,
+    geoms: BondGeoms,
+}
+
+/// A cell offset of −1..=1 along each axis as one number, 0..27.
+fn pack_offset(d: [i64; 3]) -> u8 {
+    ((d[0] + 1) * 9 + (d[1] + 1) * 3 + (d[2] + 1)) as u8
+}
+
+fn unpack_offset(v: u8) -> [i64; 3] {
+    let v = v as i64;
+    [v / 9 - 1, (v / 3) % 3 - 1, v % 3 - 1]
+}
+
 impl<M: Model> Cube<M> {
     /// Every bond, dropped pair and membership of this procCube as a record addressed to where
     /// it lives in `layout` after the particles have moved to the cells of their current
-    /// (wrapped) positions. The dropped pairs leave `self`. Collective (one ghost message, a
-    /// reduction).
-    pub(crate) fn letters(&mut self, layout: &Layout) -> Result<Letters, String> {
+    /// (wrapped) positions; the bonds that stay here as compact records. The bond list and the
+    /// dropped pairs leave `self`. Collective (one ghost message, a reduction).
+    pub(crate) fn letters(&mut self, layout: &Layout) -> Result<(Letters, Kept<M::Bond>), String> {
         // Each held particle's new cell, from its owner: ghosts never recompute it, so both
         // ends of a bond see the cell their owner sorts them into.
         let p = &self.sim.particles;
@@ -101,6 +132,7 @@ impl<M: Model> Cube<M> {
             data: Vec::new(),
         };
         let (b, gid) = (&self.sim.bonds, &self.sim.particles.gid);
+        let mut kept = Vec::with_capacity(b.len());
         let mut error = None;
         for (i, j, k) in b.iter() {
             let (gi, gj) = (gid[i], gid[j]);
@@ -129,11 +161,22 @@ impl<M: Model> Cube<M> {
             } else {
                 (j, i, d.map(|v| -v))
             };
+            let steps = to(cell[a]);
+            if steps == [0; 3] {
+                kept.push(KeptBond {
+                    a: gid[a],
+                    b: gid[c],
+                    geom: b.geom.position(k),
+                    offset: pack_offset(off),
+                    history: b.history[k],
+                });
+                continue;
+            }
             let g = b.geom[k];
             let mut rest = vec![off[0] as f64, off[1] as f64, off[2] as f64];
             rest.extend_from_slice(&[g.length, g.beta]);
             rest.extend_from_slice(b.history[k].as_slice());
-            out.push(to(cell[a]), INTACT, gid[a], gid[c], &rest);
+            out.push(steps, INTACT, gid[a], gid[c], &rest);
         }
         let dropped = std::mem::take(&mut self.dropped);
         if !dropped.is_empty() {
@@ -148,7 +191,12 @@ impl<M: Model> Cube<M> {
             Some(e) => Err(e),
             None => Ok(out),
         };
-        self.agree(mine)
+        let out = self.agree(mine)?;
+        // Everything of the old list that stays here is in `kept`: free the list before the
+        // particles move.
+        let old = std::mem::replace(&mut self.sim.bonds, BondList::empty());
+        let geoms = old.into_geom_table();
+        Ok((out, Kept { bonds: kept, geoms }))
     }
 
     /// Each owned particle's places in the boundary conditions, loads and probes, as records
@@ -172,12 +220,14 @@ impl<M: Model> Cube<M> {
         }
     }
 
-    /// The bond list of the new `plan` from the records that arrived; dropped pairs, lost
-    /// counts and memberships into `self` (by the new local indices, in global id order as
-    /// setup made them). `initial` is every local particle's initial bond count.
+    /// The bond list of the new `plan` from the bonds that stayed and the records that
+    /// arrived; dropped pairs, lost counts and memberships into `self` (by the new local
+    /// indices, in global id order as setup made them). `initial` is every local particle's
+    /// initial bond count.
     pub(crate) fn place(
         &mut self,
         letters: Letters,
+        kept: Kept<M::Bond>,
         plan: &CubePlan,
         initial: Vec<u32>,
     ) -> Result<BondList<M::Bond>, String> {
@@ -192,19 +242,46 @@ impl<M: Model> Cube<M> {
         let held: HashMap<[i64; 3], usize> = (plan.cells.held.iter().enumerate())
             .map(|(k, h)| (h.at, k))
             .collect();
+        let owned = |ga: u32| {
+            local.get(&ga).copied().ok_or_else(|| {
+                format!(
+                    "migration: a bond record for particle {ga} reached procCube {}, which does not own it; this is a bug in PDQ, please report it with the deck",
+                    plan.rank
+                )
+            })
+        };
+        // The new local indices of a bond's ends: b is found in the cell at a's plus the offset.
+        let ends = |ga: u32, gb: u32, off: [i64; 3]| -> Result<(u32, u32), String> {
+            let la = owned(ga)?;
+            let at = plan.cells.held[cell_of[la as usize]].at;
+            let target = [0, 1, 2].map(|a| at[a] + off[a]);
+            let lb = held.get(&target).and_then(|&k| {
+                let cell = plan.cell_range[k].clone();
+                let found = plan.global[cell.clone()].binary_search(&gb).ok();
+                found.map(|p| (cell.start + p) as u32)
+            });
+            match lb {
+                Some(lb) => Ok((la, lb)),
+                None => Err(format!(
+                    "migration: particle {gb}, bonded to {ga}, is not in the cell at {target:?} on procCube {}; this is a bug in PDQ, please report it with the deck",
+                    plan.rank
+                )),
+            }
+        };
+        let Kept {
+            mut bonds,
+            mut geoms,
+        } = kept;
+        for k in bonds.iter_mut() {
+            (k.a, k.b) = ends(k.a, k.b, unpack_offset(k.offset))?;
+        }
         let lh = <M::Bond as Attributes>::LEN;
-        let mut mine: Vec<(u32, u32, BondGeom, M::Bond)> = Vec::new();
         let mut constraints = vec![Vec::new(); self.sim.constraints.len()];
         let mut loads = vec![Vec::new(); self.sim.loads.len()];
         self.probes.clear();
         for r in letters.data.chunks_exact(letters.len) {
             let (ga, gb) = (r[4] as u32, r[5] as u32);
-            let Some(&la) = local.get(&ga) else {
-                return Err(format!(
-                    "migration: a bond record for particle {ga} reached procCube {}, which does not own it; this is a bug in PDQ, please report it with the deck",
-                    plan.rank
-                ));
-            };
+            let la = owned(ga)?;
             match r[3] {
                 DROPPED => self.dropped.push((ga, gb)),
                 LOST => self.lost[la as usize] += 1,
@@ -212,27 +289,22 @@ impl<M: Model> Cube<M> {
                 LOAD => loads[gb as usize].push((ga, la, r[6])),
                 PROBE => self.probes.push((gb as usize, la as usize)),
                 _ => {
-                    let at = plan.cells.held[cell_of[la as usize]].at;
-                    let target = [0, 1, 2].map(|a| at[a] + r[6 + a] as i64);
-                    let lb = held.get(&target).and_then(|&k| {
-                        let cell = plan.cell_range[k].clone();
-                        let found = plan.global[cell.clone()].binary_search(&gb).ok();
-                        found.map(|p| (cell.start + p) as u32)
-                    });
-                    let Some(lb) = lb else {
-                        return Err(format!(
-                            "migration: particle {gb}, bonded to {ga}, is not in the cell at {target:?} on procCube {}; this is a bug in PDQ, please report it with the deck",
-                            plan.rank
-                        ));
-                    };
-                    let geom = BondGeom {
+                    let (la, lb) = ends(ga, gb, [r[6], r[7], r[8]].map(|v| v as i64))?;
+                    let geom = geoms.intern(BondGeom {
                         length: r[9],
                         beta: r[10],
-                    };
-                    let mut h = M::Bond::default();
-                    h.as_mut_slice()
+                    });
+                    let mut history = M::Bond::default();
+                    history
+                        .as_mut_slice()
                         .copy_from_slice(&r[BOND_HEAD..BOND_HEAD + lh]);
-                    mine.push((la, lb, geom, h));
+                    bonds.push(KeptBond {
+                        a: la,
+                        b: lb,
+                        geom,
+                        offset: 0,
+                        history,
+                    });
                 }
             }
         }
@@ -247,7 +319,7 @@ impl<M: Model> Cube<M> {
             load.particles = m.iter().map(|&(_, l, _)| l).collect();
             load.weight = m.iter().map(|&(.., w)| w).collect();
         }
-        Ok(assemble(mine, n_owned, initial))
+        Ok(assemble(bonds, geoms, n_owned, initial))
     }
 }
 
@@ -265,26 +337,29 @@ fn cell_offset(layout: &Layout, a: [u32; 3], b: [u32; 3]) -> [i64; 3] {
     })
 }
 
-/// A bond list from (local i, local j, geometry, history) records, ordered by (i, j).
+/// A bond list from bonds by local indices, ordered by (i, j); `geoms` is the table their
+/// geometry positions point into.
 fn assemble<H: Attributes>(
-    mut mine: Vec<(u32, u32, BondGeom, H)>,
+    mut bonds: Vec<KeptBond<H>>,
+    mut geoms: BondGeoms,
     n_owned: usize,
     initial: Vec<u32>,
 ) -> BondList<H> {
-    mine.sort_unstable_by_key(|&(i, j, _, _)| (i, j));
+    bonds.sort_unstable_by_key(|b| (b.a, b.b));
     let mut offsets = vec![0u32; n_owned + 1];
-    for &(i, ..) in &mine {
-        offsets[i as usize + 1] += 1;
+    for b in &bonds {
+        offsets[b.a as usize + 1] += 1;
     }
     for i in 0..n_owned {
         offsets[i + 1] += offsets[i];
     }
-    let mut list = BondList::assemble(
-        offsets,
-        mine.iter().map(|b| b.1).collect(),
-        mine.iter().map(|b| b.2).collect(),
-        initial,
-    );
-    list.history = mine.iter().map(|b| b.3).collect();
+    let partner = bonds.iter().map(|b| b.b).collect();
+    for b in &bonds {
+        geoms.push_position(b.geom);
+    }
+    let history = bonds.iter().map(|b| b.history).collect();
+    drop(bonds);
+    let mut list = BondList::assemble(offsets, partner, geoms, initial);
+    list.history = history;
     list
 }

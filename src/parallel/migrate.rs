@@ -105,14 +105,15 @@ impl<M: Model> Cube<M> {
         let rank = self.plan.rank;
         let cells = cell_plans(&layout).swap_remove(rank);
         let before = self.sim.bonds.len() + self.dropped.len();
-        let mut letters = self.letters(&layout)?;
+        // The particles first: `letters` frees the bond list, their initial counts with it.
         let mut owned = Owned::<M>::take(self, steps);
+        let (mut letters, kept) = self.letters(&layout)?;
         self.route(MIGRATE_TAG, &mut owned);
         self.route(LETTER_TAG, &mut letters);
         let counts = owned.sort_into_cells(&cells, &layout.domain);
         self.layout = layout;
         let (part, plan, initial) = self.settle(owned, cells, counts);
-        let list = self.place(letters, &plan, initial);
+        let list = self.place(letters, kept, &plan, initial);
         let list = self.agree(list)?;
         self.install(part, list, plan);
         self.build_pair_list();
