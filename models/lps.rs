@@ -16,11 +16,13 @@
 //! "inverse_length" (ω = δ/L, LAMMPS's and Peridynamics.jl's), "gaussian"
 //! (ω = exp(−L²/(0.4δ)²)).
 
+use crate::model::lanes::{LaneForces, Real, F4, LANES, MAX_COMPONENTS};
 use crate::model::{
     check_options, stretch_line, BondGeom, Dimension, ElasticConstant, Isotropic, Material, Model,
     ModelBuild, ModelError, Sample, SampleOf, Side,
 };
 
+use super::pmb::lane_positions;
 pub use super::pmb::{Force3, Motion};
 
 crate::attributes! {
@@ -78,28 +80,29 @@ pub struct Lps {
 }
 
 impl Lps {
-    /// ω(L)/d, with at most one division (the bond loops run this for every bond).
+    /// ω(L)/d, with at most one division (the bond loops run this for every bond), on one
+    /// bond or four.
     #[inline(always)]
-    fn omega_over(&self, length: f64, d: f64) -> f64 {
+    fn omega_over<T: Real>(&self, length: T, d: T) -> T {
         match self.influence {
-            Influence::One => 1.0 / d,
-            Influence::InverseLength => self.delta / (length * d),
+            Influence::One => T::splat(1.0) / d,
+            Influence::InverseLength => T::splat(self.delta) / (length * d),
             Influence::Gaussian => {
-                let r = length / (0.4 * self.delta);
-                (-r * r).exp() / d
+                let r = length / T::splat(0.4 * self.delta);
+                (-r * r).lanewise(f64::exp) / d
             }
         }
     }
 
     /// ω(L)·L, without a division.
     #[inline(always)]
-    fn omega_length(&self, length: f64) -> f64 {
+    fn omega_length<T: Real>(&self, length: T) -> T {
         match self.influence {
             Influence::One => length,
-            Influence::InverseLength => self.delta,
+            Influence::InverseLength => T::splat(self.delta),
             Influence::Gaussian => {
-                let r = length / (0.4 * self.delta);
-                length * (-r * r).exp()
+                let r = length / T::splat(0.4 * self.delta);
+                length * (-r * r).lanewise(f64::exp)
             }
         }
     }
@@ -107,6 +110,49 @@ impl Lps {
     fn omega(&self, length: f64) -> f64 {
         self.omega_over(length, 1.0)
     }
+
+    /// A bond's share of its ends' dilatation sums before the volume of the other end:
+    /// ω L e β.
+    #[inline(always)]
+    fn dilatation_weight<T: Real>(&self, e: T, length: T, beta: T) -> T {
+        self.omega_length(length) * e * beta
+    }
+
+    /// The pair force on end i per unit bond vector: ω/r (t_i + t_j) β V_i V_j, with both
+    /// ends' dilatations `theta`, inverse weighted volumes `inv_m` and volumes `v`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn force_factor<T: Real>(
+        &self,
+        law: &LawLanes<T>,
+        length: T,
+        e: T,
+        r: T,
+        theta: [T; 2],
+        inv_m: [T; 2],
+        beta: T,
+        v: [T; 2],
+    ) -> T {
+        let t = length * (law.ai * theta[0] * inv_m[0] + law.aj * theta[1] * inv_m[1])
+            + e * (law.bi * inv_m[0] + law.bj * inv_m[1]);
+        self.omega_over(length, r) * t * beta * v[0] * v[1]
+    }
+}
+
+/// The moduli of a [`Law`] on one bond (`f64`) or four (`F4`).
+struct LawLanes<T> {
+    ai: T,
+    bi: T,
+    aj: T,
+    bj: T,
+}
+
+/// The bond vector and its length r, and the elongation r − L.
+#[inline(always)]
+fn bond_vector<T: Real>(a: [T; 3], b: [T; 3], length: T) -> ([T; 3], T, T) {
+    let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+    (y, r, r - length)
 }
 
 impl Model for Lps {
@@ -119,6 +165,7 @@ impl Model for Lps {
     )];
     const FIXED_FROM_BONDS: bool = true;
     const LAMMPS_PEER: Option<&'static str> = Some("peri/lps");
+    const BOND_LANES: usize = LANES;
 
     type Alter = Motion;
     type Fixed = WeightedVolume;
@@ -255,10 +302,8 @@ impl Model for Lps {
         geom: &BondGeom,
         _: &(),
     ) -> (Dilatation, Dilatation) {
-        let (a, b) = (i.pos(), j.pos());
-        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let e = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt() - geom.length;
-        let w = self.omega_length(geom.length) * e * geom.beta;
+        let (_, _, e) = bond_vector(i.pos(), j.pos(), geom.length);
+        let w = self.dilatation_weight(e, geom.length, geom.beta);
         (
             Dilatation {
                 dilatation: w * j.volume,
@@ -269,6 +314,30 @@ impl Model for Lps {
                 inverse_weighted_volume: 0.0,
             },
         )
+    }
+
+    /// `state` on four bonds, one per lane.
+    #[inline(always)]
+    fn state_lanes(
+        &self,
+        _: [&Law; LANES],
+        i: &Side<Self>,
+        j: [&Side<Self>; LANES],
+        geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        let (a, b) = lane_positions(i, j);
+        let length = F4::gather(|l| geom[l].length);
+        let (_, _, e) = bond_vector(a, b, length);
+        let w = self.dilatation_weight(e, length, F4::gather(|l| geom[l].beta));
+        let zero = F4::splat(0.0);
+        let mut out = LaneForces {
+            i: [zero; MAX_COMPONENTS],
+            j: [zero; MAX_COMPONENTS],
+            opposite: false,
+        };
+        out.i[0] = w * F4::gather(|l| j[l].volume);
+        out.j[0] = w * F4::splat(i.volume);
+        Some(out)
     }
 
     fn finish_state(&self, state: &mut Dilatation, fixed: &WeightedVolume) {
@@ -286,21 +355,28 @@ impl Model for Lps {
         geom: &BondGeom,
         _: &mut (),
     ) -> Option<(Force3, Force3)> {
-        let (a, b) = (i.pos(), j.pos());
-        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
         let l = geom.length;
-        let e = r - l;
+        let (y, r, e) = bond_vector(i.pos(), j.pos(), l);
         if e > law.s0 * l {
             return None;
         }
-        let (inv_mi, inv_mj) = (
-            i.state.inverse_weighted_volume,
-            j.state.inverse_weighted_volume,
+        let moduli = LawLanes {
+            ai: law.ai,
+            bi: law.bi,
+            aj: law.aj,
+            bj: law.bj,
+        };
+        let (si, sj) = (i.state, j.state);
+        let f = self.force_factor(
+            &moduli,
+            l,
+            e,
+            r,
+            [si.dilatation, sj.dilatation],
+            [si.inverse_weighted_volume, sj.inverse_weighted_volume],
+            geom.beta,
+            [i.volume, j.volume],
         );
-        let t = l * (law.ai * i.state.dilatation * inv_mi + law.aj * j.state.dilatation * inv_mj)
-            + e * (law.bi * inv_mi + law.bj * inv_mj);
-        let f = self.omega_over(l, r) * t * geom.beta * i.volume * j.volume;
         let fi = [f * y[0], f * y[1], f * y[2]];
         Some((
             Force3 { force: fi },
@@ -308,6 +384,52 @@ impl Model for Lps {
                 force: [-fi[0], -fi[1], -fi[2]],
             },
         ))
+    }
+
+    /// `pair` on four bonds, one per lane, through the same `bond_vector` and `force_factor`.
+    #[inline(always)]
+    fn pair_lanes(
+        &self,
+        law: [&Law; LANES],
+        i: &Side<Self>,
+        j: [&Side<Self>; LANES],
+        geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        let (a, b) = lane_positions(i, j);
+        let l = F4::gather(|k| geom[k].length);
+        let (y, r, e) = bond_vector(a, b, l);
+        let s0_l = F4::gather(|k| law[k].s0) * l;
+        if e.any_outside(F4::splat(f64::NEG_INFINITY), s0_l) {
+            return None;
+        }
+        let moduli = LawLanes {
+            ai: F4::gather(|k| law[k].ai),
+            bi: F4::gather(|k| law[k].bi),
+            aj: F4::gather(|k| law[k].aj),
+            bj: F4::gather(|k| law[k].bj),
+        };
+        let si = i.state;
+        let f = self.force_factor(
+            &moduli,
+            l,
+            e,
+            r,
+            [
+                F4::splat(si.dilatation),
+                F4::gather(|k| j[k].state.dilatation),
+            ],
+            [
+                F4::splat(si.inverse_weighted_volume),
+                F4::gather(|k| j[k].state.inverse_weighted_volume),
+            ],
+            F4::gather(|k| geom[k].beta),
+            [F4::splat(i.volume), F4::gather(|k| j[k].volume)],
+        );
+        let mut i = [F4::splat(0.0); MAX_COMPONENTS];
+        for c in 0..3 {
+            i[c] = f * y[c];
+        }
+        Some(LaneForces::opposite(i))
     }
 
     fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {
@@ -385,4 +507,107 @@ fn own_constants(m: &Material, delta: f64) -> Result<(f64, f64, f64), ModelError
         )));
     }
     Ok((k, g, s))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::attributes::Attributes;
+    use crate::model::lanes::fixture::{assert_same_bits, geom, moved, volume, X0};
+    use crate::model::material::{MaterialKind, PlainNumbers};
+    use crate::model::{OptionValue, Written};
+
+    fn solid(name: &str, e: f64, nu: f64, s0: f64) -> Material {
+        let keys = [
+            ("youngs_modulus", e),
+            ("poisson_ratio", nu),
+            ("critical_stretch", s0),
+        ]
+        .iter()
+        .map(|&(k, v)| (k.to_string(), Written::Number(v)))
+        .collect();
+        Material::new(name, 0, MaterialKind::Solid, 2400.0, keys, &PlainNumbers).unwrap()
+    }
+
+    /// `state_lanes` and `pair_lanes` give `state`'s and `pair`'s values bit for bit, for each
+    /// influence function and two materials, and `pair_lanes` refuses a group with a breaking
+    /// bond.
+    #[test]
+    fn lanes_give_the_single_bond_values_bit_for_bit() {
+        let materials = [solid("a", 30e9, 0.3, 0.01), solid("b", 200e9, 0.1, 0.02)];
+        for influence in ["one", "inverse_length", "gaussian"] {
+            let options = [(
+                "influence".to_string(),
+                OptionValue::Word(influence.to_string()),
+            )];
+            let m = Lps::build(&ModelBuild {
+                materials: &materials,
+                horizon: 3.015e-3,
+                spacing: 1e-3,
+                options: &options,
+            })
+            .unwrap();
+            // Particles 0-4, and particle 3 moved past its bond's critical stretch (5).
+            let mut alter: Vec<Motion> = (0..5)
+                .map(|p| Motion {
+                    pos: moved(p),
+                    vel: [0.0; 3],
+                })
+                .collect();
+            let mut far = alter[3];
+            far.pos[0] += 1e-4;
+            alter.push(far);
+            let material = [0u16, 1, 0, 1, 1];
+            // Dilatations of both signs and distinct 1/m, as after `finish_state`.
+            let fixed: Vec<WeightedVolume> = (0..5)
+                .map(|p| WeightedVolume {
+                    weighted_volume: 1e-12 * (2.0 + p as f64),
+                })
+                .collect();
+            let state: Vec<Dilatation> = (0..5)
+                .map(|p| Dilatation {
+                    dilatation: 1e-4 * (p as f64 - 2.5),
+                    inverse_weighted_volume: 1.0 / fixed[p].weighted_volume,
+                })
+                .collect();
+            let side = |p: usize, a: usize| Side::<Lps> {
+                x0: &X0[p],
+                volume: volume(p),
+                material: material[p],
+                alter: &alter[a],
+                fixed: &fixed[p],
+                state: &state[p],
+            };
+            let i = side(0, 0);
+            let js = [1, 2, 3, 4].map(|p| side(p, p));
+            let geoms = [geom(1), geom(2), geom(3), geom(4)];
+            let laws = js.each_ref().map(|j| m.law(0, j.material));
+            let (law_refs, geom_refs) = (laws.each_ref(), geoms.each_ref());
+
+            let states = m
+                .state_lanes(law_refs, &i, js.each_ref(), geom_refs)
+                .unwrap();
+            let single: [(Dilatation, Dilatation); LANES] =
+                std::array::from_fn(|l| m.state(&laws[l], &i, &js[l], &geoms[l], &()));
+            let slices = single.each_ref().map(|(a, b)| (a.as_slice(), b.as_slice()));
+            assert_same_bits(&states, slices, &format!("{influence} state"));
+
+            let forces = m
+                .pair_lanes(law_refs, &i, js.each_ref(), geom_refs)
+                .expect("no lane breaks");
+            let single: [(Force3, Force3); LANES] =
+                std::array::from_fn(|l| m.pair(&laws[l], &i, &js[l], &geoms[l], &mut ()).unwrap());
+            let slices = single.each_ref().map(|(a, b)| (a.as_slice(), b.as_slice()));
+            assert_same_bits(&forces, slices, &format!("{influence} pair"));
+            assert!(single
+                .iter()
+                .all(|(a, _)| a.force.iter().any(|&f| f != 0.0)));
+
+            let j2 = side(3, 5);
+            assert!(m.pair(&laws[2], &i, &j2, &geoms[2], &mut ()).is_none());
+            assert!(m
+                .pair_lanes(law_refs, &i, [&js[0], &js[1], &j2, &js[3]], geom_refs)
+                .is_none());
+        }
+    }
 }

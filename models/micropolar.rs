@@ -482,6 +482,7 @@ impl Model for Micropolar {
         Some(LaneForces {
             i: [f[0], f[1], f[2], m_i[0], m_i[1], m_i[2], zero, zero],
             j: [-f[0], -f[1], -f[2], m_j[0], m_j[1], m_j[2], zero, zero],
+            opposite: false,
         })
     }
 

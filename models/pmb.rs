@@ -5,6 +5,8 @@
 //! docs/theory.md §1. A bond between two materials takes the series stiffness 2c_a c_b/(c_a + c_b)
 //! and the smaller critical stretch.
 
+use crate::model::attributes::Attributes;
+use crate::model::lanes::{LaneForces, Real, F4, LANES, MAX_COMPONENTS};
 use crate::model::{
     bond_based_lame, check_options, stretch, stretch_line, BondGeom, Dimension, Material, Model,
     ModelBuild, ModelError, PairTable, Sample, SampleOf, Side,
@@ -91,11 +93,42 @@ impl Pmb {
     }
 }
 
+/// The owner's position in every lane and four partners' positions, for the lane laws of
+/// models that move particles by `Motion` (the rows start with the positions: loaded whole
+/// and transposed).
+#[inline(always)]
+pub(crate) fn lane_positions<M: Model<Alter = Motion>>(
+    i: &Side<M>,
+    j: [&Side<M>; LANES],
+) -> ([F4; 3], [F4; 3]) {
+    let [bx, by, bz, _] = F4::columns::<0>(j.map(|j| j.alter.as_slice()));
+    let a = i.alter.pos;
+    (
+        [F4::splat(a[0]), F4::splat(a[1]), F4::splat(a[2])],
+        [bx, by, bz],
+    )
+}
+
+/// The bond's elongation e = r − L and its length r (bond vector `y`), on one bond or four.
+/// Comparing e with s0·L and folding 1/L into 1/r leaves one division per bond.
+#[inline(always)]
+fn elongation<T: Real>(y: &[T; 3], length: T) -> (T, T) {
+    let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+    (r - length, r)
+}
+
+/// The force on end i per unit bond vector: c·β·V_i·V_j·s/r with s = e/L.
+#[inline(always)]
+fn factor<T: Real>(c: T, beta: T, vi: T, vj: T, e: T, length: T, r: T) -> T {
+    c * beta * vi * vj * e / (length * r)
+}
+
 impl Model for Pmb {
     const NAME: &'static str = "pmb";
     const SUMMARY: &'static str =
         "bond-based prototype microelastic brittle solid (Silling), nu = 1/4, critical stretch";
     const LAMMPS_PEER: Option<&'static str> = Some("peri/pmb");
+    const BOND_LANES: usize = LANES;
 
     type Alter = Motion;
     type Fixed = ();
@@ -176,13 +209,11 @@ impl Model for Pmb {
     ) -> Option<(Force3, Force3)> {
         let (a, b) = (i.pos(), j.pos());
         let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
-        // s = e/L; comparing e with s0·L and folding 1/L into 1/r leaves one division per bond.
-        let e = r - geom.length;
+        let (e, r) = elongation(&y, geom.length);
         if e > law.s0 * geom.length {
             return None;
         }
-        let f = law.c * geom.beta * i.volume * j.volume * e / (geom.length * r);
+        let f = factor(law.c, geom.beta, i.volume, j.volume, e, geom.length, r);
         let fi = [f * y[0], f * y[1], f * y[2]];
         Some((
             Force3 { force: fi },
@@ -192,8 +223,121 @@ impl Model for Pmb {
         ))
     }
 
+    /// Four bonds through the same `elongation` and `factor` as `pair`, one per lane: the
+    /// partners' positions are loaded as rows (a `Motion` starts with them) and transposed.
+    #[inline(always)]
+    fn pair_lanes(
+        &self,
+        law: [&Law; LANES],
+        i: &Side<Self>,
+        j: [&Side<Self>; LANES],
+        geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        let (a, b) = lane_positions(i, j);
+        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let length = F4::gather(|l| geom[l].length);
+        let (e, r) = elongation(&y, length);
+        let s0_length = F4::gather(|l| law[l].s0) * length;
+        if e.any_outside(F4::splat(f64::NEG_INFINITY), s0_length) {
+            return None;
+        }
+        let f = factor(
+            F4::gather(|l| law[l].c),
+            F4::gather(|l| geom[l].beta),
+            F4::splat(i.volume),
+            F4::gather(|l| j[l].volume),
+            e,
+            length,
+            r,
+        );
+        let mut i = [F4::splat(0.0); MAX_COMPONENTS];
+        for k in 0..3 {
+            i[k] = f * y[k];
+        }
+        Some(LaneForces::opposite(i))
+    }
+
     fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {
         let (s, _, _) = stretch(i, j, geom);
         0.5 * law.c * s * s * geom.length * geom.beta * i.volume * j.volume
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::lanes::fixture::{assert_same_bits, geom, moved, volume, X0};
+    use crate::model::material::{MaterialKind, PlainNumbers};
+    use crate::model::Written;
+
+    fn solid(name: &str, e: f64, s0: f64) -> Material {
+        let keys = [("youngs_modulus", e), ("critical_stretch", s0)]
+            .iter()
+            .map(|&(k, v)| (k.to_string(), Written::Number(v)))
+            .collect();
+        Material::new(name, 0, MaterialKind::Solid, 2400.0, keys, &PlainNumbers).unwrap()
+    }
+
+    /// `pair_lanes` gives `pair`'s forces bit for bit for two materials (stretched and
+    /// shortened bonds), and `None` when one lane breaks.
+    #[test]
+    fn lanes_give_the_single_bond_forces_bit_for_bit() {
+        let materials = [solid("a", 30e9, 0.01), solid("b", 200e9, 0.02)];
+        let m = Pmb::build(&ModelBuild {
+            materials: &materials,
+            horizon: 3.015e-3,
+            spacing: 1e-3,
+            options: &[],
+        })
+        .unwrap();
+        let alter: Vec<Motion> = (0..5)
+            .map(|p| Motion {
+                pos: moved(p),
+                vel: [0.0; 3],
+            })
+            .collect();
+        let material = [0u16, 1, 0, 1, 1];
+        let side = |p: usize| Side::<Pmb> {
+            x0: &X0[p],
+            volume: volume(p),
+            material: material[p],
+            alter: &alter[p],
+            fixed: &(),
+            state: &(),
+        };
+        let i = side(0);
+        let js = [side(1), side(2), side(3), side(4)];
+        let geoms = [geom(1), geom(2), geom(3), geom(4)];
+        let laws = js.each_ref().map(|j| m.law(0, j.material));
+        let (law_refs, geom_refs) = (laws.each_ref(), geoms.each_ref());
+        let lanes = m
+            .pair_lanes(law_refs, &i, js.each_ref(), geom_refs)
+            .expect("no lane breaks");
+        let single: [(Force3, Force3); LANES] =
+            std::array::from_fn(|l| m.pair(&laws[l], &i, &js[l], &geoms[l], &mut ()).unwrap());
+        assert_same_bits(
+            &lanes,
+            single.each_ref().map(|(a, b)| (a.as_slice(), b.as_slice())),
+            "pmb",
+        );
+        // Force on i along the bond: positive when stretched; both kinds are tested.
+        let along = |l: usize| -> f64 {
+            (0..3)
+                .map(|k| single[l].0.force[k] * (js[l].pos()[k] - i.pos()[k]))
+                .sum()
+        };
+        let signs: Vec<f64> = (0..LANES).map(along).collect();
+        assert!(signs.iter().any(|&s| s > 0.0) && signs.iter().any(|&s| s < 0.0));
+        // Lane 2 stretched past its critical stretch: the group is refused.
+        let mut far = alter[3];
+        far.pos[0] += 1e-4;
+        let j2 = Side::<Pmb> {
+            alter: &far,
+            ..side(3)
+        };
+        assert!(m.pair(&laws[2], &i, &j2, &geoms[2], &mut ()).is_none());
+        assert!(m
+            .pair_lanes(law_refs, &i, [&js[0], &js[1], &j2, &js[3]], geom_refs)
+            .is_none());
     }
 }

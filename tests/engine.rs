@@ -475,3 +475,64 @@ fn the_same_deck_gives_bit_identical_results() {
     assert_eq!(a.sim.bonds.broken, b.sim.bonds.broken);
     assert!(a.sim.particles.alter == b.sim.particles.alter);
 }
+
+/// The bond sweep runs PMB four bonds per lane group; groups with a broken bond, groups in
+/// which a bond breaks now and the ends of lists go one bond at a time. Through a crack that
+/// opens step by step (bonds breaking in the very passes compared), its forces and broken flags
+/// are those of the PMB loop written by hand one bond at a time, bit for bit.
+#[test]
+fn the_lane_sweep_gives_the_one_bond_forces_and_breaks() {
+    use pdq::engine::forces::pair_pass;
+    use pdq::lab::bench::yardstick::hand_pmb_pass;
+    let text = block(12, 5, 4, "critical_stretch = 0.001", "[time]\nsteps = 1\n");
+    let mut s = setup_pmb(&text);
+    let law = s.sim.model.laws()[0];
+    let sim = &mut s.sim;
+    let mut passes_with_breaks = 0;
+    for t in 0..40 {
+        // The two halves pulled apart and sheared a little more at each pass.
+        for i in 0..sim.particles.len() {
+            let x0 = sim.particles.x0[i];
+            let side = if x0[0] < 6e-3 { -1.0 } else { 1.0 };
+            let a = 1e-7 * t as f64;
+            sim.particles.alter[i].pos = [
+                x0[0] + side * a,
+                x0[1] + 0.3 * a * x0[2] / 4e-3,
+                x0[2] - 0.2 * side * a,
+            ];
+        }
+        let mut hand_broken = sim.bonds.broken.clone();
+        let before = hand_broken.iter().filter(|&&b| b).count();
+        let mut hand_force = vec![[0.0f64; 3]; sim.particles.len()];
+        hand_pmb_pass(
+            &sim.particles.alter,
+            &sim.particles.volume,
+            sim.bonds.offsets(),
+            sim.bonds.partners(),
+            &sim.bonds.geom,
+            &mut hand_broken,
+            &mut hand_force,
+            law.c,
+            law.s0,
+        );
+        let newly = pair_pass(&sim.model, &mut sim.particles, &mut sim.bonds);
+        assert_eq!(
+            sim.bonds.broken, hand_broken,
+            "pass {t}: broken flags differ"
+        );
+        assert_eq!(newly, hand_broken.iter().filter(|&&b| b).count() - before);
+        for (i, f) in hand_force.iter().enumerate() {
+            let g = sim.particles.force[i].force;
+            assert!(
+                g.iter().zip(f).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "pass {t}, particle {i}: {g:?} against {f:?}"
+            );
+        }
+        passes_with_breaks += usize::from(newly > 0);
+    }
+    let broken = sim.bonds.broken.iter().filter(|&&b| b).count();
+    assert!(
+        passes_with_breaks >= 3 && broken > 100,
+        "the crack must open during the compared passes: {passes_with_breaks} passes broke bonds, {broken} broken in all"
+    );
+}

@@ -111,10 +111,48 @@ where
 {
     match single_material(ends.material) {
         Some(m) => {
-            let law = model.law(m, m);
-            sweep::<_, _, _, _, _, DAMAGE>(ends, bonds, out, |_, _| law, visit)
+            let law = OneLaw(model.law(m, m));
+            sweep::<_, _, _, _, _, DAMAGE>(ends, bonds, out, law, visit)
         }
-        None => sweep::<_, _, _, _, _, DAMAGE>(ends, bonds, out, |a, b| model.law(a, b), visit),
+        None => sweep::<_, _, _, _, _, DAMAGE>(ends, bonds, out, LawPerPair(model), visit),
+    }
+}
+
+/// Where a sweep takes each bond's law from.
+trait Laws<M: Model> {
+    /// The law between materials `a` and `b`.
+    fn of(&self, a: u16, b: u16) -> M::Law;
+    /// `f` of the laws between `a` and each of `b`.
+    fn group<R>(&self, a: u16, b: [u16; LANES], f: impl FnOnce([&M::Law; LANES]) -> R) -> R;
+}
+
+/// One material: one law, read from one place (not copied per bond: four fresh copies on
+/// the stack, read back as one vector, stalled the lane loop on store forwarding).
+struct OneLaw<L>(L);
+
+impl<M: Model> Laws<M> for OneLaw<M::Law> {
+    #[inline(always)]
+    fn of(&self, _: u16, _: u16) -> M::Law {
+        self.0
+    }
+    #[inline(always)]
+    fn group<R>(&self, _: u16, _: [u16; LANES], f: impl FnOnce([&M::Law; LANES]) -> R) -> R {
+        f([&self.0; LANES])
+    }
+}
+
+/// Several materials: the model's law of each pair.
+struct LawPerPair<'a, M>(&'a M);
+
+impl<M: Model> Laws<M> for LawPerPair<'_, M> {
+    #[inline(always)]
+    fn of(&self, a: u16, b: u16) -> M::Law {
+        self.0.law(a, b)
+    }
+    #[inline(always)]
+    fn group<R>(&self, a: u16, b: [u16; LANES], f: impl FnOnce([&M::Law; LANES]) -> R) -> R {
+        let laws = b.map(|b| self.0.law(a, b));
+        f(laws.each_ref())
     }
 }
 
@@ -208,6 +246,17 @@ impl<M: Model> BondVisit<M, M::State> for StateOfBond<'_, M> {
     ) -> Option<(M::State, M::State)> {
         Some(self.0.state(law, i, j, geom, bond))
     }
+
+    #[inline(always)]
+    fn visit_lanes(
+        &self,
+        law: [&M::Law; LANES],
+        i: &Side<M>,
+        j: [&Side<M>; LANES],
+        geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        self.0.state_lanes(law, i, j, geom)
+    }
 }
 
 /// The pair pass: each bond's generalized forces on its ends, or `None` when it breaks.
@@ -258,14 +307,14 @@ fn sweep<M, T, St, L, V, const DAMAGE: bool>(
     ends: Ends<'_, M, St>,
     bonds: &mut BondList<M::Bond>,
     out: &mut [T],
-    law_of: L,
+    laws: L,
     visit: V,
 ) -> usize
 where
     M: Model,
     T: Attributes,
     St: States<M::State>,
-    L: Fn(u16, u16) -> M::Law,
+    L: Laws<M>,
     V: BondVisit<M, T>,
 {
     let Ends {
@@ -305,7 +354,10 @@ where
             fixed: &fixed_i,
             state: &state_i,
         };
+        // The owner's sum: in `oi`, or in `lane_sum` while lane groups run.
         let mut oi = T::default();
+        let mut lane_sum = OwnerSum::from(&oi);
+        let mut in_lanes = M::BOND_LANES == LANES;
         let range = offsets[i] as usize..offsets[i + 1] as usize;
         let (partner, geom) = (&partner[range.clone()], geom.slice(range.clone()));
         let (broken, history) = (&mut broken[range.clone()], &mut history[range]);
@@ -326,39 +378,39 @@ where
         let len = partner.len();
         let mut k = 0;
         while k < len {
-            // Bonds k..end go one by one.
+            // Four bonds at once if the model asks (`Model::BOND_LANES`) and the next four
+            // are intact, as one lane group; otherwise, or if the model refuses the group (one
+            // of its bonds breaks now), they go one by one. The sums are made in bond order
+            // either way.
             let mut end = k + 1;
-            // Four intact bonds at once if the model asks (`Model::BOND_LANES`): the next four
-            // intact ones, as one lane group. The sums are made in bond order either way, and
-            // broken bonds add nothing, so skipping them changes nothing. If one of the four
-            // breaks, the model says so and they go one by one.
-            if M::BOND_LANES == LANES {
-                let (at, n, next) = intact_group::<DAMAGE>(broken, k);
-                if n == LANES {
-                    let js = at.map(|b| partner[b] as usize);
-                    let sides = js.map(side);
-                    let laws = sides
-                        .each_ref()
-                        .map(|s| law_of(side_i.material, s.material));
-                    let geoms = at.map(|b| geom.get(b));
-                    let lanes = (laws.each_ref(), sides.each_ref());
-                    if let Some(f) = visit.visit_lanes(lanes.0, &side_i, lanes.1, geoms) {
-                        // SAFETY: partners are in bounds, as above.
-                        unsafe { add_lanes(&mut oi, out, js, &f) };
-                        k = next;
-                        continue;
-                    }
+            if M::BOND_LANES == LANES && k + LANES <= len {
+                if !in_lanes {
+                    lane_sum = OwnerSum::from(&oi);
+                    in_lanes = true;
                 }
-                // A refused group, or fewer than four intact bonds left (then `next` is the
-                // end of the list): one by one up to where the search stopped.
-                end = next;
+                let group = Group {
+                    owner: &side_i,
+                    js: std::array::from_fn(|l| partner[k + l] as usize),
+                    geoms: std::array::from_fn(|l| geom.get(k + l)),
+                };
+                let intact = !DAMAGE || !broken[k..k + LANES].iter().any(|&b| b);
+                // SAFETY: partners are in bounds, as above.
+                if intact && unsafe { group.run(&visit, &laws, &side, &mut lane_sum, out) } {
+                    k += LANES;
+                    continue;
+                }
+                end = k + LANES;
+            }
+            if in_lanes {
+                lane_sum.store(&mut oi);
+                in_lanes = false;
             }
             while k < end {
                 if !(DAMAGE && broken[k]) {
                     let j = partner[k] as usize;
                     let sj = side(j);
                     let r = visit.visit(
-                        &law_of(side_i.material, sj.material),
+                        &laws.of(side_i.material, sj.material),
                         &side_i,
                         &sj,
                         geom.get(k),
@@ -374,6 +426,9 @@ where
                 }
                 k += 1;
             }
+        }
+        if in_lanes {
+            lane_sum.store(&mut oi);
         }
         add_assign(&mut out[i], &oi);
     }
@@ -404,20 +459,49 @@ fn check_store<M: Model>(
     );
 }
 
-/// The next `LANES` intact bonds of a particle's list from `k` on: their places, how many
-/// were found (fewer at the list's end) and where the search stopped.
-#[inline(always)]
-fn intact_group<const DAMAGE: bool>(broken: &[bool], k: usize) -> ([usize; LANES], usize, usize) {
-    let mut at = [0usize; LANES];
-    let (mut n, mut next) = (0, k);
-    while n < LANES && next < broken.len() {
-        if !DAMAGE || !broken[next] {
-            at[n] = next;
-            n += 1;
+/// Four intact bonds of one owner, for a model with lanes.
+struct Group<'a, M: Model> {
+    owner: &'a Side<'a, M>,
+    js: [usize; LANES],
+    geoms: [&'a BondGeom; LANES],
+}
+
+impl<M: Model> Group<'_, M> {
+    /// Runs the group through the model's lane law and adds its forces to the owner's sum
+    /// `oi` and to the partners in `out`; false (nothing added) if the model refuses it.
+    ///
+    /// # Safety
+    /// Every partner in `js` is below `out.len()` and is a particle `side` may read.
+    #[inline(always)]
+    unsafe fn run<'s, T, V, L, S>(
+        &self,
+        visit: &V,
+        laws: &L,
+        side: &S,
+        oi: &mut OwnerSum,
+        out: &mut [T],
+    ) -> bool
+    where
+        T: Attributes,
+        V: BondVisit<M, T>,
+        L: Laws<M>,
+        S: Fn(usize) -> Side<'s, M>,
+        M: 's,
+    {
+        let sides = self.js.map(side);
+        let materials = sides.each_ref().map(|s| s.material);
+        let forces = laws.group(self.owner.material, materials, |laws| {
+            visit.visit_lanes(laws, self.owner, sides.each_ref(), self.geoms)
+        });
+        match forces {
+            Some(f) => {
+                // SAFETY: the caller keeps the partners in bounds.
+                unsafe { add_lanes(oi, out, self.js, &f) };
+                true
+            }
+            None => false,
         }
-        next += 1;
     }
-    (at, n, next)
 }
 
 /// Adds a bond's contributions to its two ends, or marks it broken; returns how many broke.
@@ -443,6 +527,30 @@ fn add_or_break<T: Attributes, const DAMAGE: bool>(
     }
 }
 
+/// The owner's running force sum while lane groups run: components 4b..4b + 4 in `self.0[b]`,
+/// kept in registers rather than stored and reloaded for every group.
+#[derive(Clone, Copy)]
+struct OwnerSum([F4; 2]);
+
+impl OwnerSum {
+    #[inline(always)]
+    fn from<T: Attributes>(o: &T) -> OwnerSum {
+        let s = o.as_slice();
+        let block = |c: usize| F4::load_partial(if c < s.len() { &s[c..] } else { &[] });
+        OwnerSum([block(0), block(LANES)])
+    }
+
+    #[inline(always)]
+    fn store<T: Attributes>(self, o: &mut T) {
+        let s = o.as_mut_slice();
+        let n = s.len();
+        self.0[0].store_partial(&mut s[..n.min(LANES)]);
+        if n > LANES {
+            self.0[1].store_partial(&mut s[LANES..]);
+        }
+    }
+}
+
 /// Adds a lane group's forces: lane by lane (bond order) to the owner's sum `oi`, and lane l
 /// to partner `js[l]`. Each record is handled four components at a time: the four bonds'
 /// components are turned into one vector per bond, then added as vectors, which makes the
@@ -451,7 +559,12 @@ fn add_or_break<T: Attributes, const DAMAGE: bool>(
 /// # Safety
 /// Every `js[l]` is below `out.len()`.
 #[inline(always)]
-unsafe fn add_lanes<T: Attributes>(oi: &mut T, out: &mut [T], js: [usize; LANES], f: &LaneForces) {
+unsafe fn add_lanes<T: Attributes>(
+    oi: &mut OwnerSum,
+    out: &mut [T],
+    js: [usize; LANES],
+    f: &LaneForces,
+) {
     let n = T::LEN;
     assert!(
         n <= MAX_COMPONENTS,
@@ -461,13 +574,17 @@ unsafe fn add_lanes<T: Attributes>(oi: &mut T, out: &mut [T], js: [usize; LANES]
     while c < n {
         let m = (n - c).min(LANES);
         let block = |v: &[F4; MAX_COMPONENTS]| F4::transpose([v[c], v[c + 1], v[c + 2], v[c + 3]]);
-        let (ti, tj) = (block(&f.i), block(&f.j));
-        let own = &mut oi.as_mut_slice()[c..c + m];
-        let mut sum = F4::load_partial(own);
+        let ti = block(&f.i);
+        // Equal and opposite forces need no second transpose.
+        let tj = if f.opposite {
+            ti.map(|t| -t)
+        } else {
+            block(&f.j)
+        };
+        let sum = &mut oi.0[c / LANES];
         for t in ti {
-            sum = sum + t;
+            *sum = *sum + t;
         }
-        sum.store_partial(own);
         for (l, t) in tj.into_iter().enumerate() {
             // SAFETY: the caller keeps js[l] in bounds.
             let o = &mut unsafe { out.get_unchecked_mut(js[l]) }.as_mut_slice()[c..c + m];

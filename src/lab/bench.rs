@@ -16,7 +16,7 @@ mod peer;
 mod ranks;
 mod savings;
 mod voids;
-mod yardstick;
+pub mod yardstick;
 
 use peer::{peer, peer_style};
 use ranks::ranks_line;

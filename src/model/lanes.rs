@@ -30,6 +30,9 @@ pub trait Real:
     /// The same value in every lane.
     fn splat(x: f64) -> Self;
     fn sqrt(self) -> Self;
+    /// `f` on each lane: for functions with no vector form (`exp`), the same bits as on
+    /// single values.
+    fn lanewise(self, f: impl Fn(f64) -> f64) -> Self;
 }
 
 impl Real for f64 {
@@ -41,6 +44,10 @@ impl Real for f64 {
     fn sqrt(self) -> Self {
         f64::sqrt(self)
     }
+    #[inline(always)]
+    fn lanewise(self, f: impl Fn(f64) -> f64) -> Self {
+        f(self)
+    }
 }
 
 /// Most generalized-force components a model with lanes may have (micropolar: 6).
@@ -48,11 +55,25 @@ pub const MAX_COMPONENTS: usize = 8;
 
 /// The generalized forces of a lane group on its two ends: element k holds component k of the
 /// force record (the model's `Force` viewed as `f64`s) of each bond, one bond per lane.
-/// Elements past the record's length are ignored.
+/// Elements past the record's length are ignored. With `opposite`, the forces on j are those
+/// on i negated and `j` is not read (bond-based laws: one transpose instead of two).
 #[derive(Clone, Copy, Debug)]
 pub struct LaneForces {
     pub i: [F4; MAX_COMPONENTS],
     pub j: [F4; MAX_COMPONENTS],
+    pub opposite: bool,
+}
+
+impl LaneForces {
+    /// Forces `i` on the owners and their negatives on the partners.
+    #[inline(always)]
+    pub fn opposite(i: [F4; MAX_COMPONENTS]) -> LaneForces {
+        LaneForces {
+            i,
+            j: i,
+            opposite: true,
+        }
+    }
 }
 
 /// Methods both forms of `F4` build from their `load`, `store`, `gather` and `transpose`.
@@ -224,6 +245,11 @@ mod register {
             // SAFETY: AVX is enabled for the whole build (see the type).
             F4(unsafe { _mm256_sqrt_pd(self.0) })
         }
+        #[inline(always)]
+        fn lanewise(self, f: impl Fn(f64) -> f64) -> Self {
+            let a = self.to_array();
+            F4::gather(|l| f(a[l]))
+        }
     }
 }
 
@@ -322,6 +348,70 @@ mod array {
             let a = self.0;
             F4([a[0].sqrt(), a[1].sqrt(), a[2].sqrt(), a[3].sqrt()])
         }
+        #[inline(always)]
+        fn lanewise(self, f: impl Fn(f64) -> f64) -> Self {
+            let a = self.0;
+            F4([f(a[0]), f(a[1]), f(a[2]), f(a[3])])
+        }
+    }
+}
+
+/// Five particles for the models' lane tests: particle 0 bonded to 1–4.
+#[cfg(test)]
+pub(crate) mod fixture {
+    use super::{LaneForces, LANES};
+    use crate::model::BondGeom;
+
+    /// Reference positions (spacing 1 mm).
+    pub const X0: [[f64; 3]; 5] = [
+        [0.0, 0.0, 0.0],
+        [1e-3, 0.0, 0.0],
+        [0.0, 2e-3, 1e-3],
+        [1e-3, 1e-3, 1e-3],
+        [-2e-3, 1e-3, 0.0],
+    ];
+
+    /// Current positions: displacements of a few parts in a thousand of the spacing, both
+    /// signs, so that some bonds stretch and some shorten.
+    pub fn moved(p: usize) -> [f64; 3] {
+        std::array::from_fn(|k| X0[p][k] + 1e-6 * ((7 * p + 3 * k) % 5) as f64 - 2e-6)
+    }
+
+    /// Particle p's volume.
+    pub fn volume(p: usize) -> f64 {
+        1e-9 * (1.0 + p as f64 / 10.0)
+    }
+
+    /// The geometry of bond 0–p (p = 1..=4), with a volume correction below one.
+    pub fn geom(p: usize) -> BondGeom {
+        let d: [f64; 3] = std::array::from_fn(|k| X0[p][k] - X0[0][k]);
+        BondGeom {
+            length: (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(),
+            beta: 1.0 - p as f64 / 20.0,
+        }
+    }
+
+    /// Lane l of `lanes` is `single[l]` (the two ends' records) bit for bit.
+    pub fn assert_same_bits(lanes: &LaneForces, single: [(&[f64], &[f64]); LANES], what: &str) {
+        for (l, (i, j)) in single.iter().enumerate() {
+            for (c, (x, y)) in i.iter().zip(j.iter()).enumerate() {
+                let on_j = if lanes.opposite {
+                    -lanes.i[c]
+                } else {
+                    lanes.j[c]
+                };
+                assert_eq!(
+                    lanes.i[c].lane(l).to_bits(),
+                    x.to_bits(),
+                    "{what}: lane {l} i {c}"
+                );
+                assert_eq!(
+                    on_j.lane(l).to_bits(),
+                    y.to_bits(),
+                    "{what}: lane {l} j {c}"
+                );
+            }
+        }
     }
 }
 
@@ -341,7 +431,7 @@ mod tests {
                     let x = [0.1, -3.7e-5, 12.5, 7.0 / 3.0];
                     let y = [1.0 / 7.0, 2.2e8, -0.3, 1e-300];
                     fn law<T: Real>(a: T, b: T) -> T {
-                        ((a * b + T::splat(0.5)) / (a - b)).sqrt() + -(a / b)
+                        ((a * b + T::splat(0.5)) / (a - b)).sqrt() + -(a / b).lanewise(f64::exp)
                     }
                     let v = law(F4::gather(|l| x[l]), F4::gather(|l| y[l]));
                     for l in 0..LANES {

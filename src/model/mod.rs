@@ -293,6 +293,19 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
         (Self::State::default(), Self::State::default())
     }
 
+    /// [`Model::state`] of four intact bonds of particle `i` at once, as
+    /// [`Model::pair_lanes`] is to [`Model::pair`]: component k of the `State` record in
+    /// element k, bit for bit `state`'s values. `None` (the default): one by one.
+    fn state_lanes(
+        &self,
+        _law: [&Self::Law; LANES],
+        _i: &Side<Self>,
+        _j: [&Side<Self>; LANES],
+        _geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        None
+    }
+
     /// Turns a particle's summed state into its final value (e.g. θ = 3/m·Σ…); it may also
     /// fill fields the pair pass wants per particle (LPS keeps 1/m there), which the sums leave
     /// at zero.
