@@ -317,6 +317,10 @@ where
     L: Laws<M>,
     V: BondVisit<M, T>,
 {
+    for o in out.iter_mut() {
+        *o = T::default();
+    }
+    ends_check(&ends, out.len(), bonds);
     let Ends {
         n_owned,
         x0,
@@ -326,20 +330,7 @@ where
         alter,
         state,
     } = ends;
-    for o in out.iter_mut() {
-        *o = T::default();
-    }
-    let bonds_max_partner = bonds.max_partner();
     let (offsets, partner, geom, broken, history) = bonds.parts_mut();
-    let lengths = [
-        volume.len(),
-        material.len(),
-        fixed.len(),
-        alter.len(),
-        out.len(),
-    ];
-    let (n, n_state) = (x0.len(), state.len());
-    check_store::<M>(n_owned, n, &lengths, n_state, offsets, bonds_max_partner);
     let mut newly_broken = 0;
     for i in 0..n_owned {
         // Local copies: the compiler cannot tell that the stores into `out` below leave
@@ -433,6 +424,31 @@ where
         add_assign(&mut out[i], &oi);
     }
     newly_broken
+}
+
+/// [`check_store`] for one sweep's per-particle arrays, its output and its bond list.
+fn ends_check<M: Model, St: States<M::State>, B: Attributes>(
+    ends: &Ends<'_, M, St>,
+    n_out: usize,
+    bonds: &BondList<B>,
+) {
+    let lengths = [
+        ends.volume.len(),
+        ends.material.len(),
+        ends.fixed.len(),
+        ends.alter.len(),
+        n_out,
+    ];
+    let n = ends.x0.len();
+    let offsets = bonds.offsets();
+    check_store::<M>(
+        ends.n_owned,
+        n,
+        &lengths,
+        ends.state.len(),
+        offsets,
+        bonds.max_partner(),
+    );
 }
 
 /// The bond list and the particle store must agree: this is what makes the unchecked partner
