@@ -382,7 +382,7 @@ fn validate(a: ValidateArgs) -> Result<(), String> {
         print!("{s}");
         return Ok(());
     }
-    let (table, ok) = pdq::lab::validate::run_all(&pdq::lab::validate::ValidateOptions {
+    let (table, failures) = pdq::lab::validate::run_all(&pdq::lab::validate::ValidateOptions {
         cases: a.case_dir,
         implicit: a.solver.map_or(!a.full, |s| s == "implicit"),
         level: if a.full {
@@ -395,10 +395,18 @@ fn validate(a: ValidateArgs) -> Result<(), String> {
         threads,
     })?;
     print!("{table}");
-    if ok {
+    if failures.is_empty() {
         Ok(())
     } else {
-        Err("an elastic case is outside its tolerance (see the table)".into())
+        Err(format!(
+            "{} of the validation failed:\n  {}",
+            if failures.len() == 1 {
+                "a case"
+            } else {
+                "cases"
+            },
+            failures.join("\n  ")
+        ))
     }
 }
 

@@ -77,6 +77,7 @@ history_every = 1
             thesis: None,
             formula: "none".into(),
             tolerance_percent: 2.0,
+            band: None,
             deck: deck.into(),
             extract: Box::new(|_, dir| validate::last_of(dir, "tip_ux")),
             damage_views: false,
@@ -97,6 +98,7 @@ history_every = 1
         thesis: None,
         formula: "twice the answer".into(),
         tolerance_percent: 2.0,
+        band: None,
         deck: deck.into(),
         extract: Box::new(|_, dir| validate::last_of(dir, "tip_ux")),
         damage_views: false,
@@ -249,5 +251,76 @@ fn the_fast_lap_splice_pulls_out() {
         o.measured
     );
     assert!(o.views.as_deref().is_some_and(Path::exists));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A case whose solve stops at its iteration limit fails the suite, whatever its error: the
+/// PMB cantilever by ADR with 50 iterations where it needs thousands. Its table row says so.
+#[test]
+fn an_unconverged_solve_fails_its_case() {
+    let limit = |deck: &mut toml::Table| -> Result<(), String> {
+        let solver = deck["solver"].as_table_mut().ok_or("no [solver]")?;
+        solver.insert("max_iterations".into(), toml::Value::Integer(50));
+        Ok(())
+    };
+    let path = Path::new("validation/cantilever_pmb.toml");
+    let case = validate::case_file::load_with(path, Level::Quick, false, Some(&limit)).unwrap();
+    let dir = out("unconverged");
+    let o = validate::run_case(&case, &dir.join(&case.name), 1).unwrap();
+    assert_eq!(o.converged, Some(false));
+    let why = o.failures(Level::Quick);
+    assert!(
+        why.iter().any(|w| w.contains("did not converge")),
+        "{why:?}"
+    );
+    let table = validate::table(std::slice::from_ref(&o));
+    assert!(table.contains("| **NO** |"), "{table}");
+    // The same case solved as written converges.
+    let case = validate::case_file::load(path, Level::Quick, true).unwrap();
+    let o = validate::run_case(&case, &dir.join(&case.name), 1).unwrap();
+    assert_eq!(o.converged, Some(true));
+    assert!(
+        o.failures(Level::Quick).is_empty(),
+        "{:?}",
+        o.failures(Level::Quick)
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// The regression band catches a change of the concrete physics that the formula's 15 % would
+/// let through: the fastest lap splice as recorded stays in its band; with the concrete's
+/// tensile stretch 10 % higher it leaves it, and the suite names the case and the band.
+#[test]
+fn a_concrete_parameter_changed_by_ten_percent_leaves_the_band() {
+    let path = Path::new("validation/lap_splice_fast.toml");
+    let dir = out("band");
+    let as_recorded = validate::case_file::load(path, Level::Quick, false).unwrap();
+    assert!(as_recorded.band.is_some(), "lap_splice_fast has no band");
+    let o = validate::run_case(&as_recorded, &dir.join("recorded"), 2).unwrap();
+    assert!(
+        o.failures(Level::Quick).is_empty(),
+        "{:?}",
+        o.failures(Level::Quick)
+    );
+    let stronger = |deck: &mut toml::Table| -> Result<(), String> {
+        let concrete = deck["materials"]["concrete"]
+            .as_table_mut()
+            .ok_or("no [materials.concrete]")?;
+        let s = concrete["tensile_stretch"]
+            .as_float()
+            .ok_or("no tensile_stretch")?;
+        concrete.insert("tensile_stretch".into(), toml::Value::Float(1.1 * s));
+        Ok(())
+    };
+    let changed =
+        validate::case_file::load_with(path, Level::Quick, false, Some(&stronger)).unwrap();
+    let o = validate::run_case(&changed, &dir.join("changed"), 2).unwrap();
+    let why = o.failures(Level::Quick);
+    assert!(
+        why.iter().any(|w| w.contains("left its regression band")),
+        "{} moved only to {:.5e}: {why:?}",
+        o.name,
+        o.measured
+    );
     let _ = std::fs::remove_dir_all(dir);
 }

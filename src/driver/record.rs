@@ -526,7 +526,9 @@ pub(crate) fn finish<M: Model>(
         checkpoints: tally.checkpoints,
         first_step: plan.first_step,
         force_evaluations: tally.evaluations,
+        load_steps: tally.load_steps,
         converged_steps: tally.converged,
+        last_step_converged: tally.solved.is_none_or(|r| r.converged),
         stopped_at_broken: tally.stopped_at_broken,
         stopped_at_probe: tally.stopped_at_probe,
     }))

@@ -51,13 +51,33 @@ pub struct Summary {
     /// Force evaluations of the step loop: one per step explicitly, the iterations of every
     /// load step under relaxation.
     pub force_evaluations: u64,
-    /// Under relaxation: load steps that reached the tolerance within `max_iterations`.
+    /// Under relaxation (ADR or the implicit solve): the load steps solved (0 in an explicit
+    /// run), those that reached the tolerance within `max_iterations`, and whether the last
+    /// one did.
+    pub load_steps: u64,
     pub converged_steps: u64,
+    pub last_step_converged: bool,
     /// The run ended before its last step because `[time] stop_at_broken_bonds` was reached.
     pub stopped_at_broken: bool,
     /// The run ended before its last step because this probe's displacement passed its
     /// `stop_beyond`.
     pub stopped_at_probe: Option<String>,
+}
+
+impl Summary {
+    /// Whether the run's solve converged: `None` for an explicit run (nothing iterates),
+    /// else whether every load step reached its tolerance. A run that stopped early (at
+    /// `stop_at_broken_bonds` or a probe's `stop_beyond`) may end inside its last load step,
+    /// unconverged by design; every step before it must have converged.
+    pub fn solve_converged(&self) -> Option<bool> {
+        if self.load_steps == 0 {
+            return None;
+        }
+        let stopped = self.stopped_at_broken || self.stopped_at_probe.is_some();
+        let earlier = self.load_steps - u64::from(!self.last_step_converged);
+        let earlier_converged = self.converged_steps == earlier;
+        Some(earlier_converged && (self.last_step_converged || stopped))
+    }
 }
 
 /// Options the command line may set over the deck.

@@ -118,6 +118,8 @@ impl SolverChoice {
 #[derive(Default)]
 pub(crate) struct Tally {
     pub evaluations: u64,
+    /// Load steps solved by relaxation, and how many of them reached the tolerance.
+    pub load_steps: u64,
     pub converged: u64,
     /// The last load step's solve (quasi-static solvers).
     pub solved: Option<Relaxed>,
@@ -136,6 +138,7 @@ impl Tally {
         match solved {
             Some(r) => {
                 self.evaluations += r.iterations;
+                self.load_steps += 1;
                 self.converged += r.converged as u64;
                 self.solved = Some(r);
             }

@@ -33,12 +33,29 @@ pub enum Level {
     Full,
 }
 
-/// Elastic cases must meet their tolerance; strength cases report.
+/// Elastic cases must meet their tolerance against the formula; strength cases report
+/// theirs, and must stay in their regression band.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Kind {
     Elastic,
     Strength,
+}
+
+/// A regression band: the value a case last measured and how far (per cent of it) a run may
+/// move from it before the suite fails. Re-measured on purpose when the physics changes
+/// (validation/README.md, "Regression bands").
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Band {
+    pub value: f64,
+    pub percent: f64,
+}
+
+impl Band {
+    pub fn holds(&self, measured: f64) -> bool {
+        (measured - self.value).abs() <= 0.01 * self.percent * self.value.abs()
+    }
 }
 
 /// Reads a curve, as (x, y) points, from a run's output directory.
@@ -67,6 +84,8 @@ pub struct Case {
     /// Where the reference comes from.
     pub formula: String,
     pub tolerance_percent: f64,
+    /// The regression band at this level (required of strength cases at `--quick`).
+    pub band: Option<Band>,
     pub deck: String,
     /// The measured value from the run's summary and output directory.
     pub extract: Extractor,
@@ -90,7 +109,11 @@ pub struct Outcome {
     pub particles: usize,
     pub force_evaluations: u64,
     pub seconds: f64,
+    /// Within the tolerance against the formula.
     pub passed: bool,
+    /// Whether the solve converged (`None`: an explicit run, nothing iterates).
+    pub converged: Option<bool>,
+    pub band: Option<Band>,
     pub plot: Option<PathBuf>,
     /// The damage picture (side and 3D views), for the cases that draw one.
     pub views: Option<PathBuf>,
@@ -125,6 +148,7 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
     let measured = (case.extract)(&summary, dir)?;
     let error_percent = 100.0 * (measured - case.reference) / case.reference;
     let passed = measured.is_finite() && error_percent.abs() <= case.tolerance_percent;
+    let converged = summary.solve_converged();
     let plot = match &case.plot {
         Some(pl) => {
             let measured_curve = (pl.measured)(dir)?;
@@ -194,9 +218,72 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
         force_evaluations: summary.force_evaluations,
         seconds,
         passed,
+        converged,
+        band: case.band,
         plot,
         views,
     })
+}
+
+impl Outcome {
+    /// Why the case fails the suite, if it does: its solve did not converge, it is elastic
+    /// and outside its tolerance, it has left its regression band, or it is a strength case
+    /// at `--quick` without one.
+    pub fn failures(&self, level: Level) -> Vec<String> {
+        let mut why = Vec::new();
+        if self.converged == Some(false) {
+            why.push(format!(
+                "{}: the solve did not converge (a load step ended at its max_iterations)",
+                self.name
+            ));
+        }
+        if self.kind == Kind::Elastic && !self.passed {
+            why.push(format!(
+                "{}: {:+.2} % against the formula, outside its {} %",
+                self.name, self.error_percent, self.tolerance_percent
+            ));
+        }
+        let file = format!("{}.toml (the case directory)", self.name);
+        let table = match level {
+            Level::Quick => "[validation]",
+            Level::Full => "[validation.full]",
+        };
+        match self.band {
+            Some(b) if !b.holds(self.measured) => why.push(format!(
+                "{}: {:.5e} left its regression band {:.5e} ± {} % ({:+.2} %); if the change is meant, re-measure it: {table} regression = {{ value = {:.5e}, percent = {} }} in {file}",
+                self.name,
+                self.measured,
+                b.value,
+                b.percent,
+                100.0 * (self.measured - b.value) / b.value,
+                self.measured,
+                b.percent
+            )),
+            None if self.kind == Kind::Strength && level == Level::Quick => why.push(format!(
+                "{}: a strength case without a regression band: record this run's value, {table} regression = {{ value = {:.5e}, percent = 2.0 }} in {file}",
+                self.name, self.measured
+            )),
+            _ => {}
+        }
+        why
+    }
+
+    /// The band column: the band and whether the value is in it.
+    fn band_cell(&self) -> String {
+        match self.band {
+            Some(b) if b.holds(self.measured) => {
+                format!("{:.5e} ± {} %: in", b.value, b.percent)
+            }
+            Some(b) => format!(
+                "{:.5e} ± {} %: **OUT** ({:+.2} %)",
+                b.value,
+                b.percent,
+                100.0 * (self.measured - b.value) / b.value
+            ),
+            None if self.kind == Kind::Strength => "none recorded".to_string(),
+            None => "–".to_string(),
+        }
+    }
 }
 
 /// The table `pdq validate` prints and writes into `report.md`.
@@ -204,23 +291,28 @@ pub fn table(outcomes: &[Outcome]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| case | quantity | PDQ | reference | error % | tolerance % | result | thesis (PDQ against it) | particles | force evaluations | run time s |"
+        "| case | quantity | PDQ | reference | error % | tolerance % | result | converged | regression band | thesis (PDQ against it) | particles | force evaluations | run time s |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for o in outcomes {
-        // Strength cases report against their tolerance; only elastic ones fail the run.
+        // Strength cases report against their tolerance (their regression band can fail them).
         let result = match (o.kind, o.passed) {
             (Kind::Strength, true) => "within",
             (Kind::Strength, false) => "outside",
             (Kind::Elastic, true) => "pass",
             (Kind::Elastic, false) => "FAIL",
         };
+        let converged = match o.converged {
+            Some(true) => "yes",
+            Some(false) => "**NO**",
+            None => "explicit",
+        };
         let thesis = o.thesis.map_or("–".to_string(), |t| {
             format!("{t:.5e} ({:+.2} %)", 100.0 * (o.measured - t) / t)
         });
         let _ = writeln!(
             s,
-            "| {} | {} ({}) | {:.5e} | {:.5e} | {:+.2} | {} | {} | {} | {} | {} | {:.1} |",
+            "| {} | {} ({}) | {:.5e} | {:.5e} | {:+.2} | {} | {} | {} | {} | {} | {} | {} | {:.1} |",
             o.name,
             o.quantity,
             o.unit,
@@ -229,6 +321,8 @@ pub fn table(outcomes: &[Outcome]) -> String {
             o.error_percent,
             o.tolerance_percent,
             result,
+            converged,
+            o.band_cell(),
             thesis,
             o.particles,
             o.force_evaluations,
@@ -259,8 +353,9 @@ pub fn cases(dir: &Path, level: Level, implicit: bool) -> Result<Vec<Case>, Stri
 }
 
 /// Runs the cases, writes `report.md` into the output directory and returns the table and
-/// whether every elastic case met its tolerance.
-pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
+/// why cases failed (none when every solve converged, every elastic case met its tolerance
+/// and every case with a regression band stayed in it).
+pub fn run_all(opts: &ValidateOptions) -> Result<(String, Vec<String>), String> {
     let all = cases(&opts.cases, opts.level, opts.implicit)?;
     for name in &opts.only {
         if !all.iter().any(|c| &c.name == name) {
@@ -279,10 +374,11 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, bool), String> {
     let outcomes = run_chosen(&chosen, opts)?;
     let t = table(&outcomes);
     write_report(opts, &t, &outcomes)?;
-    let ok = outcomes
+    let failures = outcomes
         .iter()
-        .all(|o| o.passed || o.kind == Kind::Strength);
-    Ok((t, ok))
+        .flat_map(|o| o.failures(opts.level))
+        .collect();
+    Ok((t, failures))
 }
 
 /// Runs `chosen`, returning their outcomes in the same order.

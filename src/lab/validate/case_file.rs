@@ -6,7 +6,7 @@
 
 use super::formulas::Formula;
 use super::measures::Measure;
-use super::{Case, Kind, Level, Plot};
+use super::{Band, Case, Kind, Level, Plot};
 use crate::input::deck;
 use serde::Deserialize;
 use std::path::Path;
@@ -28,6 +28,8 @@ struct Validation {
     reference: Formula,
     measure: Measure,
     plot: PlotLabels,
+    /// The value last measured at `--quick` and how far a run may move from it.
+    regression: Option<Band>,
     /// What `--full` changes: the deck (merged over this one) and the table's entries.
     full: Option<FullLevel>,
     /// What `--solver implicit` merges into the deck (elastic cases).
@@ -46,6 +48,8 @@ struct PlotLabels {
 struct FullLevel {
     tolerance_percent: Option<f64>,
     quantity: Option<String>,
+    /// The value last measured at `--full` (the `--quick` band does not carry over).
+    regression: Option<Band>,
     #[serde(default)]
     deck: toml::Table,
 }
@@ -116,12 +120,26 @@ pub fn load_with(
         .and_then(|s| s.to_str())
         .unwrap_or_default();
     let (mut tolerance, mut quantity, mut changed) = (v.tolerance_percent, v.quantity, false);
+    let mut band = v.regression;
+    if level == Level::Full {
+        band = v.full.as_ref().and_then(|f| f.regression);
+    }
     if let (Level::Full, Some(full)) = (level, &v.full) {
         merge(&mut deck, &full.deck, "")
             .map_err(|e| format!("{}: [validation.full]: {e}", path.display()))?;
         tolerance = full.tolerance_percent.unwrap_or(tolerance);
         quantity = full.quantity.clone().unwrap_or(quantity);
         changed = true;
+    }
+    if let Some(b) = band {
+        if !(b.value.is_finite() && b.percent.is_finite() && b.percent > 0.0) {
+            return Err(format!(
+                "{}: [validation] regression = {{ value = {}, percent = {} }}: give a finite value and a percent above 0",
+                path.display(),
+                b.value,
+                b.percent
+            ));
+        }
     }
     if implicit && v.kind == Kind::Elastic {
         let patch = v.implicit.as_ref().ok_or_else(|| {
@@ -162,6 +180,7 @@ pub fn load_with(
         thesis: v.thesis,
         formula,
         tolerance_percent: tolerance,
+        band,
         deck: text,
         extract,
         damage_views: v.damage_views,
