@@ -44,7 +44,7 @@ pub enum Kind {
 
 /// A regression band: the value a case last measured and how far (per cent of it) a run may
 /// move from it before the suite fails. Re-measured on purpose when the physics changes
-/// (validation/README.md, "Regression bands").
+/// (validation/README.md, "What fails the suite").
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Band {
@@ -53,8 +53,13 @@ pub struct Band {
 }
 
 impl Band {
+    /// How far `measured` is from the band's value, per cent of it.
+    pub fn deviation_percent(&self, measured: f64) -> f64 {
+        100.0 * (measured - self.value) / self.value.abs()
+    }
+
     pub fn holds(&self, measured: f64) -> bool {
-        (measured - self.value).abs() <= 0.01 * self.percent * self.value.abs()
+        self.deviation_percent(measured).abs() <= self.percent
     }
 }
 
@@ -255,7 +260,7 @@ impl Outcome {
                 self.measured,
                 b.value,
                 b.percent,
-                100.0 * (self.measured - b.value) / b.value,
+                b.deviation_percent(self.measured),
                 self.measured,
                 b.percent
             )),
@@ -278,7 +283,7 @@ impl Outcome {
                 "{:.5e} ± {} %: **OUT** ({:+.2} %)",
                 b.value,
                 b.percent,
-                100.0 * (self.measured - b.value) / b.value
+                b.deviation_percent(self.measured)
             ),
             None if self.kind == Kind::Strength => "none recorded".to_string(),
             None => "–".to_string(),

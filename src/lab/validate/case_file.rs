@@ -120,10 +120,13 @@ pub fn load_with(
         .and_then(|s| s.to_str())
         .unwrap_or_default();
     let (mut tolerance, mut quantity, mut changed) = (v.tolerance_percent, v.quantity, false);
-    let mut band = v.regression;
-    if level == Level::Full {
-        band = v.full.as_ref().and_then(|f| f.regression);
-    }
+    let (band, band_table) = match level {
+        Level::Quick => (v.regression, "[validation]"),
+        Level::Full => (
+            v.full.as_ref().and_then(|f| f.regression),
+            "[validation.full]",
+        ),
+    };
     if let (Level::Full, Some(full)) = (level, &v.full) {
         merge(&mut deck, &full.deck, "")
             .map_err(|e| format!("{}: [validation.full]: {e}", path.display()))?;
@@ -134,7 +137,7 @@ pub fn load_with(
     if let Some(b) = band {
         if !(b.value.is_finite() && b.percent.is_finite() && b.percent > 0.0) {
             return Err(format!(
-                "{}: [validation] regression = {{ value = {}, percent = {} }}: give a finite value and a percent above 0",
+                "{}: {band_table} regression = {{ value = {}, percent = {} }}: give a finite value and a percent above 0",
                 path.display(),
                 b.value,
                 b.percent
