@@ -158,10 +158,10 @@ struct ValidateArgs {
     #[arg(long, default_value_t = 5.0)]
     ramp_periods: f64,
     /// Quasi-static solver of the elastic cases: "implicit" (Newton with the assembled
-    /// tangent, one thread; the same answers as ADR in a fraction of the time) or "adr".
-    /// Default: implicit with --quick, adr with --full (the factored tangent of the full
-    /// micropolar beam outgrows 24 GiB).
-    #[arg(long, value_parser = ["adr", "implicit"])]
+    /// tangent, one thread; the same answers as ADR in a fraction of the time; matrix-free
+    /// where the factor would not fit), "newton_krylov" (Newton, matrix-free, every thread)
+    /// or "adr". Default: implicit with --quick, adr with --full.
+    #[arg(long, value_parser = ["adr", "implicit", "newton_krylov"])]
     solver: Option<String>,
     /// Instead of the cases: the elastic cantilever swept over resolution, m and solver;
     /// error against run time (sweep.md, sweep.png).
@@ -176,7 +176,7 @@ struct ValidateArgs {
     /// Sweep: horizon ratios m, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "2,3,4")]
     m: Vec<f64>,
-    /// Sweep: solvers, comma-separated (implicit, adr).
+    /// Sweep: solvers, comma-separated (implicit, newton_krylov, adr).
     #[arg(long, value_delimiter = ',', default_value = "implicit")]
     solvers: Vec<String>,
 }
@@ -384,7 +384,11 @@ fn validate(a: ValidateArgs) -> Result<(), String> {
     }
     let (table, failures) = pdq::lab::validate::run_all(&pdq::lab::validate::ValidateOptions {
         cases: a.case_dir,
-        implicit: a.solver.map_or(!a.full, |s| s == "implicit"),
+        solver: match a.solver.as_deref() {
+            Some(word) => pdq::lab::validate::ElasticSolver::named(word)?,
+            None if a.full => pdq::lab::validate::ElasticSolver::Adr,
+            None => pdq::lab::validate::ElasticSolver::Implicit,
+        },
         level: if a.full {
             pdq::lab::validate::Level::Full
         } else {

@@ -13,7 +13,7 @@ fn an_unknown_case_is_refused_with_the_list() {
     let e = validate::run_all(&ValidateOptions {
         cases: "validation".into(),
         level: Level::Quick,
-        implicit: false,
+        solver: validate::ElasticSolver::Adr,
         only: vec!["cantilever_steel".into()],
         output: out("unknown"),
         threads: 1,
@@ -183,13 +183,16 @@ fn the_sweep_reports_error_against_run_time() {
 /// prestressed strands.
 #[test]
 fn every_case_deck_parses() {
-    for (level, implicit) in [
-        (Level::Quick, false),
-        (Level::Quick, true),
-        (Level::Full, false),
-        (Level::Full, true),
+    use validate::ElasticSolver::{Adr, Implicit, NewtonKrylov};
+    for (level, solver) in [
+        (Level::Quick, Adr),
+        (Level::Quick, Implicit),
+        (Level::Quick, NewtonKrylov),
+        (Level::Full, Adr),
+        (Level::Full, Implicit),
+        (Level::Full, NewtonKrylov),
     ] {
-        for case in validate::cases(Path::new("validation"), level, implicit).unwrap() {
+        for case in validate::cases(Path::new("validation"), level, solver).unwrap() {
             let name = format!("{}.toml", case.name);
             if let Err(e) = pdq::input::deck::parse(&case.deck, &name, &case.name) {
                 panic!("{:?} {}: {e}", level, case.name);
@@ -231,11 +234,15 @@ fn every_case_deck_parses() {
 /// the run), and the damage picture is drawn.
 #[test]
 fn the_fast_lap_splice_pulls_out() {
-    let case = validate::cases(Path::new("validation"), Level::Quick, false)
-        .unwrap()
-        .into_iter()
-        .find(|c| c.name == "lap_splice_fast")
-        .expect("the case exists");
+    let case = validate::cases(
+        Path::new("validation"),
+        Level::Quick,
+        validate::ElasticSolver::Adr,
+    )
+    .unwrap()
+    .into_iter()
+    .find(|c| c.name == "lap_splice_fast")
+    .expect("the case exists");
     let dir = out("lap");
     let o = validate::run_case(&case, &dir.join(&case.name), 1).expect("the case runs");
     assert!(o.measured.is_finite() && o.measured > 0.0, "{}", o.measured);
@@ -264,7 +271,13 @@ fn an_unconverged_solve_fails_its_case() {
         Ok(())
     };
     let path = Path::new("validation/cantilever_pmb.toml");
-    let case = validate::case_file::load_with(path, Level::Quick, false, Some(&limit)).unwrap();
+    let case = validate::case_file::load_with(
+        path,
+        Level::Quick,
+        validate::ElasticSolver::Adr,
+        Some(&limit),
+    )
+    .unwrap();
     let dir = out("unconverged");
     let o = validate::run_case(&case, &dir.join(&case.name), 1).unwrap();
     assert_eq!(o.converged, Some(false));
@@ -276,7 +289,8 @@ fn an_unconverged_solve_fails_its_case() {
     let table = validate::table(std::slice::from_ref(&o));
     assert!(table.contains("| **NO** |"), "{table}");
     // The same case solved as written converges.
-    let case = validate::case_file::load(path, Level::Quick, true).unwrap();
+    let case =
+        validate::case_file::load(path, Level::Quick, validate::ElasticSolver::Implicit).unwrap();
     let o = validate::run_case(&case, &dir.join(&case.name), 1).unwrap();
     assert_eq!(o.converged, Some(true));
     assert!(
@@ -294,7 +308,8 @@ fn an_unconverged_solve_fails_its_case() {
 fn a_concrete_parameter_changed_by_ten_percent_leaves_the_band() {
     let path = Path::new("validation/lap_splice_fast.toml");
     let dir = out("band");
-    let as_recorded = validate::case_file::load(path, Level::Quick, false).unwrap();
+    let as_recorded =
+        validate::case_file::load(path, Level::Quick, validate::ElasticSolver::Adr).unwrap();
     assert!(as_recorded.band.is_some(), "lap_splice_fast has no band");
     let o = validate::run_case(&as_recorded, &dir.join("recorded"), 2).unwrap();
     assert!(
@@ -312,8 +327,13 @@ fn a_concrete_parameter_changed_by_ten_percent_leaves_the_band() {
         concrete.insert("tensile_stretch".into(), toml::Value::Float(1.1 * s));
         Ok(())
     };
-    let changed =
-        validate::case_file::load_with(path, Level::Quick, false, Some(&stronger)).unwrap();
+    let changed = validate::case_file::load_with(
+        path,
+        Level::Quick,
+        validate::ElasticSolver::Adr,
+        Some(&stronger),
+    )
+    .unwrap();
     let o = validate::run_case(&changed, &dir.join("changed"), 2).unwrap();
     let why = o.failures(Level::Quick);
     assert!(

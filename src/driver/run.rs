@@ -4,7 +4,7 @@ use super::observers::analysis::AnalysisPlan;
 use super::record::{columns, frame_store};
 use super::step_loop::{drive, CheckpointPlan, Plan, SolverChoice};
 use super::thermo::Thermo;
-use crate::input::deck::{Colouring, Scene, SolverSpec};
+use crate::input::deck::{Colouring, Equilibrium, Scene, SolverSpec};
 use crate::input::setup::{self, Setup};
 use crate::model::{Model, ModelVisitor};
 use crate::output::checkpoint::{self, Checkpoint};
@@ -171,15 +171,22 @@ fn solver_choice<M: Model>(
         SolverSpec::Relaxation {
             tolerance,
             max_iterations,
-            implicit,
+            method,
+            krylov_iterations,
             ..
         } => {
-            crate::solve::adr::check_model::<M>(implicit)
+            let newton = method != Equilibrium::Relaxation;
+            crate::solve::adr::check_model::<M>(newton)
                 .map_err(|e| format!("{}:{}: {e}", scene.file, scene.solver.line))?;
-            if implicit {
+            if newton {
                 SolverChoice::Implicit {
                     tolerance,
                     max_iterations,
+                    matrix_free: crate::solve::MatrixFree {
+                        diagonal: crate::solve::krylov::Diagonal::of(&setup.sim),
+                        max_iterations: krylov_iterations,
+                        always: method == Equilibrium::NewtonKrylov,
+                    },
                 }
             } else {
                 let mass = crate::solve::adr::fictitious_mass(&mut setup.sim);
@@ -292,18 +299,6 @@ struct Prepared<'a, M: Model> {
 }
 
 impl<M: Model> Prepared<'_, M> {
-    /// The implicit solve assembles one matrix in one process.
-    fn one_cube(&self, layout: &Layout) -> Result<(), String> {
-        let cubes: usize = layout.procs.iter().product();
-        if matches!(self.solver, SolverChoice::Implicit { .. }) && cubes > 1 {
-            return Err(format!(
-                "{}:{}: [solver] kind = \"implicit\" runs on one procCube, the layout has {cubes} (--threads 1, no mpirun); use kind = \"adr\" for several",
-                self.scene.file, self.scene.solver.line
-            ));
-        }
-        Ok(())
-    }
-
     /// Said after the run's header (`prepare`), by the root only.
     fn say_static(&self, quiet: bool) {
         if let (Some(s), false) = (&self.static_start, quiet) {
@@ -366,7 +361,6 @@ impl<M: Model> Prepared<'_, M> {
         let (scene, opts) = (self.scene, self.opts);
         let (rank, ranks) = (mpi.rank(), mpi.size());
         let layout = choose_layout(&self.setup, scene, opts, ranks)?;
-        self.one_cube(&layout)?;
         // Every rank makes the directory (the same one, on a shared file system), so that a
         // failure stops them all instead of leaving some waiting for the root.
         let quiet = RunOptions {
@@ -404,7 +398,6 @@ impl<M: Model> Prepared<'_, M> {
         let (scene, opts) = (self.scene, self.opts);
         let threads = opts.threads.unwrap_or(scene.parallel.threads);
         let layout = choose_layout(&self.setup, scene, opts, threads)?;
-        self.one_cube(&layout)?;
         prepare(
             &self.setup,
             scene,

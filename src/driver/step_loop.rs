@@ -77,10 +77,12 @@ pub(crate) enum SolverChoice {
         tolerance: f64,
         max_iterations: u64,
     },
-    /// Newton's method with the assembled tangent (`src/solve/implicit.rs`).
+    /// Newton's method (`src/solve/newton.rs`): the factored tangent where it serves, else
+    /// (or always, as `matrix_free.always` says) matrix-free.
     Implicit {
         tolerance: f64,
         max_iterations: u64,
+        matrix_free: crate::solve::MatrixFree,
     },
 }
 
@@ -101,7 +103,11 @@ impl SolverChoice {
             SolverChoice::Implicit {
                 tolerance,
                 max_iterations,
-            } => Box::new(Newton::new(*tolerance, *max_iterations, stop_at_broken)),
+                matrix_free,
+            } => Box::new(
+                Newton::new(*tolerance, *max_iterations, stop_at_broken)
+                    .with_matrix_free(matrix_free.clone(), root),
+            ),
         }
     }
 

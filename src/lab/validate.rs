@@ -21,6 +21,7 @@ pub mod formulas;
 pub mod measures;
 mod sweep;
 
+pub use case_file::ElasticSolver;
 pub use measures::{last_of, read_history};
 pub use sweep::{compare_adr, sweep, SweepPoint};
 
@@ -343,8 +344,8 @@ pub struct ValidateOptions {
     /// The directory of the case files (`validation/`).
     pub cases: PathBuf,
     pub level: Level,
-    /// Solve the elastic cases by the implicit solve instead of ADR (one thread).
-    pub implicit: bool,
+    /// How the elastic cases are solved (the factored implicit solve runs on one thread).
+    pub solver: ElasticSolver,
     /// Case names to run (all when empty).
     pub only: Vec<String>,
     pub output: PathBuf,
@@ -352,16 +353,16 @@ pub struct ValidateOptions {
 }
 
 /// The cases of a level, in report order: the files that `dir/suite.toml` lists (the elastic
-/// ones by the implicit solve if `implicit`).
-pub fn cases(dir: &Path, level: Level, implicit: bool) -> Result<Vec<Case>, String> {
-    case_file::load_suite(dir, level, implicit)
+/// ones by `solver`).
+pub fn cases(dir: &Path, level: Level, solver: ElasticSolver) -> Result<Vec<Case>, String> {
+    case_file::load_suite(dir, level, solver)
 }
 
 /// Runs the cases, writes `report.md` into the output directory and returns the table and
 /// why cases failed (none when every solve converged, every elastic case met its tolerance
 /// and every case with a regression band stayed in it).
 pub fn run_all(opts: &ValidateOptions) -> Result<(String, Vec<String>), String> {
-    let all = cases(&opts.cases, opts.level, opts.implicit)?;
+    let all = cases(&opts.cases, opts.level, opts.solver)?;
     for name in &opts.only {
         if !all.iter().any(|c| &c.name == name) {
             let names: Vec<&str> = all.iter().map(|c| c.name.as_str()).collect();
@@ -389,10 +390,15 @@ pub fn run_all(opts: &ValidateOptions) -> Result<(String, Vec<String>), String> 
 /// Runs `chosen`, returning their outcomes in the same order.
 fn run_chosen(chosen: &[&Case], opts: &ValidateOptions) -> Result<Vec<Outcome>, String> {
     let threads = opts.threads;
-    // An implicit solve assembles one matrix in one process, on one thread. At --quick those
-    // cases are small, so they run side by side, `threads` at a time, while the others get
-    // every thread one after another; at --full a factored tangent can fill the machine alone.
-    let is_implicit = |c: &Case| c.deck.contains("kind = \"implicit\"");
+    // A factored implicit solve assembles one matrix in one process, on one thread. At --quick
+    // the Newton cases (factored or matrix-free) are small, so they run side by side, one
+    // thread each, `threads` at a time, while the others get every thread one after another;
+    // at --full a factored tangent can fill the machine alone, and a matrix-free solve gets
+    // every thread.
+    let is_implicit = |c: &Case| {
+        c.deck.contains("kind = \"implicit\"")
+            || (opts.level == Level::Quick && c.deck.contains("kind = \"newton_krylov\""))
+    };
     let at_once = if opts.level == Level::Quick {
         threads
     } else {
@@ -435,10 +441,10 @@ fn write_report(opts: &ValidateOptions, t: &str, outcomes: &[Outcome]) -> Result
             Level::Quick => "--quick",
             Level::Full => "--full",
         },
-        if opts.implicit {
-            "the implicit solve"
-        } else {
-            "ADR"
+        match opts.solver {
+            ElasticSolver::Implicit => "the implicit solve",
+            ElasticSolver::NewtonKrylov => "Newton–Krylov",
+            ElasticSolver::Adr => "ADR",
         }
     );
     report.push_str(t);

@@ -83,19 +83,8 @@ pub struct FictitiousMass {
 /// store (the setup's, before the procCubes are cut). The scene is left as it was found.
 pub fn fictitious_mass<M: Model>(sim: &mut Simulation<M>) -> FictitiousMass {
     let n2 = second_order::<M>();
-    let (model, p) = (&sim.model, &sim.particles);
-    let sums =
-        crate::engine::simulation::stiffness_sums_of(model, p, &sim.bonds, |law, i, j, geom| {
-            model.relaxation_stiffness(law, &p.side(i), &p.side(j), geom)
-        });
-    let p = &sim.particles;
-    let n = p.n_owned;
-    let mut shape = vec![0.0; n * n2];
-    for (i, sum) in sums.iter().enumerate().take(n) {
-        for k in 0..n2 {
-            shape[i * n2 + k] = p.volume[i] * sum.as_slice()[k];
-        }
-    }
+    let n = sim.particles.n_owned;
+    let shape = gershgorin_shape(sim);
     let mut free = sim.free_dofs();
     for (f, &b) in free.iter_mut().zip(&shape) {
         *f &= b > 0.0;
@@ -122,6 +111,25 @@ pub fn fictitious_mass<M: Model>(sim: &mut Simulation<M>) -> FictitiousMass {
         lambda_max,
         evaluations,
     }
+}
+
+/// The Gershgorin shape of the stiffness, b_i = V_i Σ_j V_j C_ij for each second-order DOF of
+/// the owned particles in store order, C_ij from [`Model::relaxation_stiffness`]: ADR's masses
+/// before their scaling, and the matrix-free Newton solve's diagonal preconditioner.
+pub fn gershgorin_shape<M: Model>(sim: &Simulation<M>) -> Vec<f64> {
+    let n2 = second_order::<M>();
+    let (model, p) = (&sim.model, &sim.particles);
+    let sums =
+        crate::engine::simulation::stiffness_sums_of(model, p, &sim.bonds, |law, i, j, geom| {
+            model.relaxation_stiffness(law, &p.side(i), &p.side(j), geom)
+        });
+    let mut shape = vec![0.0; p.n_owned * n2];
+    for (i, sum) in sums.iter().enumerate().take(p.n_owned) {
+        for k in 0..n2 {
+            shape[i * n2 + k] = p.volume[i] * sum.as_slice()[k];
+        }
+    }
+    shape
 }
 
 /// Second-order coordinates minus their reference (translations from x0, rotations from 0).

@@ -1,8 +1,9 @@
-//! Implicit static solve: Newton's method on the equilibrium equations with the tangent
+//! The factored tangent of the implicit static solve ([`crate::solve::Newton`]): the tangent
 //! stiffness assembled as a sparse matrix and factored by `faer` (sparse Cholesky; once bonds
 //! have broken, Cholesky with a slightly raised diagonal; LU if neither works), after a check
-//! that the factor fits in memory. For elastic states it reaches equilibrium in a few force
-//! evaluations per load step where relaxation needs thousands.
+//! that the factor fits in memory. For elastic states Newton reaches equilibrium with it in a
+//! few force evaluations per load step where relaxation needs thousands. Where it does not fit,
+//! or the layout has several procCubes, Newton solves matrix-free (`solve/krylov.rs`).
 //!
 //! The tangent is assembled from the engine's own force evaluation, for every model alike
 //! (bond-based, state-based, micropolar): columns by central differences, many at once. Two
@@ -11,21 +12,13 @@
 //! over a family), so particles more than twice that reach apart share a "colour". Each colour
 //! costs 2 force evaluations per degree of freedom. Rotations are perturbed through the model's
 //! own `drift`, so finite-rotation coordinates (quaternions) are handled as the integrator
-//! handles them.
-//!
-//! The tangent is kept while the Newton iterations at least halve the residual and rebuilt
-//! when they do not (modified Newton): a few broken bonds leave it usable. Loads are dead loads; supported DOFs are eliminated (their motion is imposed
-//! before the iterations, as in relaxation). One procCube only: the matrix is assembled and
+//! handles them. Supported DOFs are eliminated. One procCube only: the matrix is assembled and
 //! factored in one process.
 
 use crate::engine::particles::Particles;
-use crate::engine::timing::Phase;
 use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model, Side};
-use crate::parallel::comm::Reduce;
 use crate::parallel::Cube;
-use crate::solve::adr::{begin_load_step, zero_velocities, Relaxed};
-use crate::solve::Solver;
 use faer::prelude::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use std::time::Instant;
@@ -198,6 +191,28 @@ fn bond_blocks<M: Model>(
     triplets
 }
 
+/// Why the tangent was not factored.
+#[derive(Debug)]
+pub enum NoTangent {
+    /// The factor would not fit in memory: the matrix-free solve needs none.
+    WouldNotFit(String),
+    Failed(String),
+}
+
+impl From<String> for NoTangent {
+    fn from(e: String) -> Self {
+        NoTangent::Failed(e)
+    }
+}
+
+impl From<NoTangent> for String {
+    fn from(e: NoTangent) -> Self {
+        match e {
+            NoTangent::WouldNotFit(e) | NoTangent::Failed(e) => e,
+        }
+    }
+}
+
 /// The factor may take at most this fraction of the memory the system reports available. The
 /// estimate below is already generous (twice the factor's values: the full micropolar beam's
 /// estimate was 26.5 GiB; the kernel killed it at 24 GiB), so all of it.
@@ -207,7 +222,7 @@ const FACTOR_MEMORY_SHARE: f64 = 1.0;
 /// symbolic factorization (ordering and column counts, cheap) gives the factor's nonzeros
 /// before any memory is spent on it. Without this check an oversized factor is not an error
 /// but the kernel's out-of-memory kill, after an hour and with the run's results lost.
-fn check_factor_memory(lower: &SparseColMat<usize, f64>, free: usize) -> Result<(), String> {
+fn check_factor_memory(lower: &SparseColMat<usize, f64>, free: usize) -> Result<(), NoTangent> {
     let Some(available) = available_memory() else {
         return Ok(());
     };
@@ -222,12 +237,12 @@ fn check_factor_memory(lower: &SparseColMat<usize, f64>, free: usize) -> Result<
     let needed = 2.0 * symbolic.len_val() as f64 * std::mem::size_of::<f64>() as f64;
     if needed > FACTOR_MEMORY_SHARE * available {
         let gib = |b: f64| b / (1u64 << 30) as f64;
-        return Err(format!(
+        return Err(NoTangent::WouldNotFit(format!(
             "the implicit solve's factored tangent would need about {:.1} GiB ({} nonzeros over {free} free DOFs), more than the {:.1} GiB of memory available",
             gib(needed),
             symbolic.len_val(),
             gib(FACTOR_MEMORY_SHARE * available)
-        ));
+        )));
     }
     Ok(())
 }
@@ -279,7 +294,7 @@ fn factor(
     evaluations: u64,
     colours: usize,
     start: Instant,
-) -> Result<Tangent, String> {
+) -> Result<Tangent, NoTangent> {
     let nonzeros = triplets.len();
     let lower = SparseColMat::<usize, f64>::try_new_from_triplets(free, free, &triplets)
         .map_err(|e| format!("assembling the tangent stiffness: {e:?}"))?;
@@ -323,15 +338,17 @@ fn factor(
 
 /// Assembles and factors the tangent stiffness at the current state. Bonds, their
 /// history and the forces are left as they were.
-pub fn assemble_tangent<M: Model>(cube: &mut Cube<M>) -> Result<Tangent, String> {
+pub fn assemble_tangent<M: Model>(cube: &mut Cube<M>) -> Result<Tangent, NoTangent> {
     let start = Instant::now();
     let n2 = second_order::<M>();
     let n = cube.sim.particles.n_owned;
     if cube.layout.domain.periodic.iter().any(|&p| p) {
-        return Err("the implicit solve does not handle periodic axes (it finds who feels whom from reference positions)".into());
+        return Err(NoTangent::Failed("the implicit solve does not handle periodic axes (it finds who feels whom from reference positions)".into()));
     }
     if cube.sim.particles.len() != n || cube.wall.transport().size() != 1 {
-        return Err("the implicit solve runs on one procCube (--threads 1, no mpirun): the tangent is assembled and factored in one process".into());
+        return Err(NoTangent::Failed(
+            "the factored tangent is assembled on one procCube (--threads 1, no mpirun)".into(),
+        ));
     }
     // Supported DOFs.
     let mut free = 0;
@@ -353,7 +370,9 @@ pub fn assemble_tangent<M: Model>(cube: &mut Cube<M>) -> Result<Tangent, String>
         shortest = shortest.min(g.length);
     }
     if longest == 0.0 {
-        return Err("the implicit solve needs bonds: the scene has none".into());
+        return Err(NoTangent::Failed(
+            "the implicit solve needs bonds: the scene has none".into(),
+        ));
     }
     if <M::State as Attributes>::LEN == 0 {
         let triplets = bond_blocks(
@@ -379,7 +398,7 @@ fn state_tangent<M: Model>(
     shortest: f64,
     reach: f64,
     start: Instant,
-) -> Result<Tangent, String> {
+) -> Result<Tangent, NoTangent> {
     let n2 = second_order::<M>();
     let n = cube.sim.particles.n_owned;
     let colours = colour(&cube.sim.particles.x0[..n], reach);
@@ -460,130 +479,23 @@ fn state_tangent<M: Model>(
     )
 }
 
-/// Newton's method with the assembled tangent stiffness, on one procCube; the tangent is kept
-/// between load steps and rebuilt when an iteration does not halve the residual.
-pub struct Newton {
-    pub tolerance: f64,
-    pub max_iterations: u64,
-    /// `[time] stop_at_broken_bonds` (0 = off): the iterations end there.
-    pub stop_at_broken: u64,
-    tangent: Option<Tangent>,
-}
-
-impl Newton {
-    pub fn new(tolerance: f64, max_iterations: u64, stop_at_broken: u64) -> Self {
-        Newton {
-            tolerance,
-            max_iterations,
-            stop_at_broken,
-            tangent: None,
+impl Tangent {
+    /// δ = K⁻¹F on the owned DOFs in store order (`force`: F on them; zero at supported DOFs).
+    pub fn solve(&self, force: &[f64]) -> Vec<f64> {
+        let mut rhs = faer::Mat::<f64>::zeros(self.free, 1);
+        for (idx, &f) in force.iter().enumerate() {
+            let r = self.index[idx];
+            if r != usize::MAX {
+                rhs[(r, 0)] = f;
+            }
         }
-    }
-
-    /// The tangent the last load step factored, if it needed one.
-    pub fn tangent(&self) -> Option<&Tangent> {
-        self.tangent.as_ref()
-    }
-
-    /// One load step of the implicit solve: supports and loads move to `sim.time + sim.dt`,
-    /// then Newton iterations with the (re)assembled tangent until the residual force is below
-    /// the tolerance × (applied forces and reactions), as relaxation measures it. With
-    /// `stop_at_broken` > 0 the iterations end, unconverged, once that many bonds have broken:
-    /// the run ends there (`[time] stop_at_broken_bonds`), so a new tangent would be wasted.
-    pub fn load_step<M: Model>(&mut self, cube: &mut Cube<M>) -> Result<Relaxed, String> {
-        let (tolerance, max_iterations, stop_broken) =
-            (self.tolerance, self.max_iterations, self.stop_at_broken);
-        let tangent = &mut self.tangent;
-        let n2 = second_order::<M>();
-        let n = cube.sim.particles.n_owned;
-        begin_load_step(cube);
-
-        let mut evaluations = 0u64;
-        let mut newton = 0u64;
-        let mut residual;
-        let mut previous = f64::INFINITY;
-        loop {
-            cube.compute_forces();
-            evaluations += 1;
-            let t = Instant::now();
-            let p = &cube.sim.particles;
-            let mut sums = vec![0.0];
-            for f in &p.force[..n] {
-                sums[0] += f.as_slice()[..n2].iter().map(|v| v * v).sum::<f64>();
-            }
-            for l in &cube.sim.loads {
-                sums.extend_from_slice(&l.total(cube.sim.time));
-            }
-            for c in &cube.sim.constraints {
-                sums.extend_from_slice(&c.reaction);
-            }
-            cube.team().reduce(&mut sums, Reduce::Sum);
-            let scale = sums[1..].iter().map(|x| x * x).sum::<f64>().sqrt();
-            residual = sums[0].sqrt() / scale.max(f64::MIN_POSITIVE);
-            cube.sim.timing.lap(Phase::Integration, t);
-            if residual <= tolerance
-                || newton >= max_iterations
-                || (stop_broken > 0 && cube.broken_count() as u64 >= stop_broken)
-            {
-                break;
-            }
-            let last_residual = std::mem::replace(&mut previous, residual);
-            // Rebuilt when the last iteration did not halve the residual: the tangent of an
-            // earlier state (modified Newton) no longer serves, as when many bonds have broken
-            // or the structure's rotations grow (geometric stiffness). A few broken bonds
-            // leave it good enough: the stale tangent is stiffer than the true one, so the
-            // iterations still converge, and rebuilding at every break made a cracking run
-            // spend nearly all its time assembling.
-            let slow = newton > 0 && residual > 0.5 * last_residual;
-            if slow || tangent.is_none() {
-                let k = assemble_tangent(cube)?;
-                evaluations += k.evaluations;
-                *tangent = Some(k);
-            }
-            let t = Instant::now();
-            let k = tangent.as_ref().expect("assembled above");
-            let mut rhs = faer::Mat::<f64>::zeros(k.free, 1);
-            let p = &cube.sim.particles;
-            for (i, f) in p.force[..n].iter().enumerate() {
-                for (l, &f) in f.as_slice()[..n2].iter().enumerate() {
-                    let r = k.index[i * n2 + l];
-                    if r != usize::MAX {
-                        rhs[(r, 0)] = f;
-                    }
-                }
-            }
-            match &k.factor {
-                Factor::Cholesky(f) => f.solve_in_place(rhs.as_mut()),
-                Factor::Lu(f) => f.solve_in_place(rhs.as_mut()),
-            }
-            // u += K⁻¹F, through the model's drift (rotations compose).
-            let sim = &mut cube.sim;
-            for i in 0..n {
-                let a = sim.particles.alter[i].as_mut_slice();
-                for l in 0..n2 {
-                    let r = k.index[i * n2 + l];
-                    a[n2 + l] = if r == usize::MAX { 0.0 } else { rhs[(r, 0)] };
-                }
-                sim.model.drift(&mut sim.particles.alter[i], 1.0);
-            }
-            zero_velocities(&mut sim.particles);
-            newton += 1;
-            sim.timing.lap(Phase::Integration, t);
+        match &self.factor {
+            Factor::Cholesky(f) => f.solve_in_place(rhs.as_mut()),
+            Factor::Lu(f) => f.solve_in_place(rhs.as_mut()),
         }
-        Ok(Relaxed {
-            iterations: evaluations,
-            residual,
-            converged: residual <= tolerance,
-            diverged: false,
-        })
-    }
-}
-
-impl<M: Model> Solver<M> for Newton {
-    fn advance(&mut self, cube: &mut Cube<M>, _step: u64) -> Result<Option<Relaxed>, String> {
-        self.load_step(cube).map(Some).map_err(|e| {
-            format!("{e} (or use [solver] kind = \"adr\", which assembles no tangent)")
-        })
+        (self.index.iter())
+            .map(|&r| if r == usize::MAX { 0.0 } else { rhs[(r, 0)] })
+            .collect()
     }
 }
 

@@ -68,7 +68,13 @@ pub fn solve<M: Model>(setup: &Setup<M>, until: f64, walls: Walls) -> Result<Sta
     cube.start();
     // One load step from 0 to `until`.
     cube.sim.dt = until;
-    let mut newton = Newton::new(TOLERANCE, MAX_ITERATIONS, 0);
+    // Matrix-free where the factor would not fit (`solve/newton.rs`).
+    let matrix_free = crate::solve::MatrixFree {
+        diagonal: crate::solve::krylov::Diagonal::of(&setup.sim),
+        max_iterations: crate::input::deck::DEFAULT_KRYLOV_ITERATIONS,
+        always: false,
+    };
+    let mut newton = Newton::new(TOLERANCE, MAX_ITERATIONS, 0).with_matrix_free(matrix_free, false);
     let r = newton
         .load_step(&mut cube)
         .map_err(|e| format!("[time] static_until: {e} (or leave static_until out)"))?;
@@ -81,9 +87,11 @@ pub fn solve<M: Model>(setup: &Setup<M>, until: f64, walls: Walls) -> Result<Sta
     }
     let broken = cube.broken_count();
     // No tangent when the start state is already in equilibrium (no load yet at `until`).
-    let (method, nonzeros) = newton
-        .tangent()
-        .map_or(("not needed", 0), |k| (k.method, k.nonzeros));
+    let (method, nonzeros) = match newton.tangent() {
+        _ if newton.is_matrix_free() => ("matrix-free", 0),
+        Some(k) => (k.method, k.nonzeros),
+        None => ("not needed", 0),
+    };
     cube.sim.dt = setup.sim.dt;
     cube.sim.step = 0;
     cube.sim.time = until;

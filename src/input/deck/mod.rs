@@ -34,9 +34,11 @@ mod time;
 pub use super::materials::MaterialLines;
 pub use spec::{
     AnalysisKind, AnalysisSpec, BarSpec, BoundarySpec, Colouring, CriticalStep, DeformSpec,
-    InitialSpec, LoadKind, LoadSpec, Located, ModelLines, OutputSpec, ParallelSpec, ProbeSpec,
-    Region, RunLength, Scene, SolverSpec, ThermostatKind, ThermostatSpec, TimeSpec, VelocitySpec,
+    Equilibrium, InitialSpec, LoadKind, LoadSpec, Located, ModelLines, OutputSpec, ParallelSpec,
+    ProbeSpec, Region, RunLength, Scene, SolverSpec, ThermostatKind, ThermostatSpec, TimeSpec,
+    VelocitySpec,
 };
+pub use time::DEFAULT_KRYLOV_ITERATIONS;
 
 use convert::{Converter, LineIndex};
 use sections::DeckFile;

@@ -54,8 +54,8 @@ pub(super) struct DeckFile {
     pub(super) _validation: Option<toml::Table>,
 }
 
-/// `[solver]`: explicit time stepping (the default) or quasi-static adaptive dynamic
-/// relaxation.
+/// `[solver]`: explicit time stepping (the default) or quasi-static load steps (adaptive
+/// dynamic relaxation, Newton with the factored tangent, Newton–Krylov).
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct SolverSection {
@@ -63,6 +63,7 @@ pub(super) struct SolverSection {
     pub(super) load_steps: Option<u64>,
     pub(super) tolerance: Option<f64>,
     pub(super) max_iterations: Option<u64>,
+    pub(super) krylov_iterations: Option<u64>,
 }
 
 /// `procs` is `[nx, ny, nz]` or `"auto"`.

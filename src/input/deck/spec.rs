@@ -179,9 +179,23 @@ pub enum SolverSpec {
         tolerance: f64,
         /// Force evaluations per load step (ADR), Newton iterations per load step (implicit).
         max_iterations: u64,
-        /// Newton's method with the assembled tangent (`kind = "implicit"`) instead of ADR.
-        implicit: bool,
+        /// How each load step reaches equilibrium.
+        method: Equilibrium,
+        /// Conjugate-gradient iterations per Newton iteration of the matrix-free solve.
+        krylov_iterations: u64,
     },
+}
+
+/// How a quasi-static load step reaches equilibrium (`[solver] kind`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Equilibrium {
+    /// Adaptive dynamic relaxation (`"adr"`).
+    Relaxation,
+    /// Newton's method (`"implicit"`): the factored tangent where it fits in memory on one
+    /// procCube, else the matrix-free linear solve.
+    Newton,
+    /// Newton's method with the matrix-free linear solve always (`"newton_krylov"`).
+    NewtonKrylov,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -3,9 +3,15 @@
 
 use super::convert::{Converter, R};
 use super::sections::{SolverSection, TimeSection};
-use super::spec::{CriticalStep, Located, RunLength, SolverSpec, TimeSpec};
+use super::spec::{CriticalStep, Equilibrium, Located, RunLength, SolverSpec, TimeSpec};
 use crate::engine::simulation::Integrator;
 use toml::Spanned;
+
+/// Conjugate-gradient iterations per Newton iteration of the matrix-free solve, unless the deck
+/// says: preconditioned CG on a slender beam takes a few times (length / spacing)² / (depth /
+/// spacing) iterations (the suite's finest cantilever about 10,000); the cap is for a tangent
+/// that is not positive definite, which CG would otherwise wander on.
+pub const DEFAULT_KRYLOV_ITERATIONS: u64 = 50_000;
 
 impl Converter {
     /// `[time]`; `bondless` names a model without bonds, which has no stable step to take a
@@ -159,20 +165,36 @@ impl Converter {
         }
         let item = match s.kind.as_str() {
             "explicit" => {
-                if s.load_steps.is_some() || s.tolerance.is_some() || s.max_iterations.is_some() {
-                    return self.err(line, "[solver] load_steps, tolerance and max_iterations belong to kind = \"adr\" or \"implicit\"");
+                if s.load_steps.is_some()
+                    || s.tolerance.is_some()
+                    || s.max_iterations.is_some()
+                    || s.krylov_iterations.is_some()
+                {
+                    return self.err(line, "[solver] load_steps, tolerance, max_iterations and krylov_iterations belong to kind = \"adr\", \"implicit\" or \"newton_krylov\"");
                 }
                 SolverSpec::Explicit
             }
-            kind @ ("adr" | "implicit") => {
-                let implicit = kind == "implicit";
+            kind @ ("adr" | "implicit" | "newton_krylov") => {
+                let method = match kind {
+                    "adr" => Equilibrium::Relaxation,
+                    "implicit" => Equilibrium::Newton,
+                    _ => Equilibrium::NewtonKrylov,
+                };
+                let newton = method != Equilibrium::Relaxation;
+                if !newton && s.krylov_iterations.is_some() {
+                    return self.err(line, "[solver] krylov_iterations belongs to kind = \"implicit\" or \"newton_krylov\" (the conjugate-gradient iterations of the matrix-free solve)");
+                }
                 let load_steps = s.load_steps.unwrap_or(10);
-                let tolerance = s.tolerance.unwrap_or(if implicit { 1e-8 } else { 1e-4 });
-                let max_iterations =
-                    s.max_iterations
-                        .unwrap_or(if implicit { 20 } else { 100_000 });
-                if load_steps == 0 || max_iterations == 0 {
-                    return self.err(line, "[solver] load_steps and max_iterations must be ≥ 1");
+                let tolerance = s.tolerance.unwrap_or(if newton { 1e-8 } else { 1e-4 });
+                let max_iterations = s
+                    .max_iterations
+                    .unwrap_or(if newton { 20 } else { 100_000 });
+                let krylov_iterations = s.krylov_iterations.unwrap_or(DEFAULT_KRYLOV_ITERATIONS);
+                if load_steps == 0 || max_iterations == 0 || krylov_iterations == 0 {
+                    return self.err(
+                        line,
+                        "[solver] load_steps, max_iterations and krylov_iterations must be ≥ 1",
+                    );
                 }
                 if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
                     return self.err(
@@ -186,14 +208,15 @@ impl Converter {
                     load_steps,
                     tolerance,
                     max_iterations,
-                    implicit,
+                    method,
+                    krylov_iterations,
                 }
             }
             other => {
                 return self.err(
                     line,
                     format!(
-                    "[solver] unknown kind '{other}' (use \"explicit\", \"adr\" or \"implicit\")"
+                    "[solver] unknown kind '{other}' (use \"explicit\", \"adr\", \"implicit\" or \"newton_krylov\")"
                 ),
                 )
             }

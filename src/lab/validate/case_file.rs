@@ -61,9 +61,42 @@ struct Suite {
     cases: Vec<String>,
 }
 
-/// The cases listed in `dir/suite.toml`, in its order, at `level`; by the implicit solve
-/// where a case says how. A case file the list leaves out is refused, not skipped.
-pub fn load_suite(dir: &Path, level: Level, implicit: bool) -> Result<Vec<Case>, String> {
+/// How the elastic cases are solved: by their deck's ADR, or by Newton with the case's
+/// `[validation.implicit]` settings, the tangent factored (`"implicit"`) or matrix-free
+/// (`"newton_krylov"`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ElasticSolver {
+    Adr,
+    Implicit,
+    NewtonKrylov,
+}
+
+impl ElasticSolver {
+    /// The solver a `--solver` word names.
+    pub fn named(word: &str) -> Result<Self, String> {
+        match word {
+            "adr" => Ok(ElasticSolver::Adr),
+            "implicit" => Ok(ElasticSolver::Implicit),
+            "newton_krylov" => Ok(ElasticSolver::NewtonKrylov),
+            other => Err(format!(
+                "unknown solver '{other}' (use implicit, newton_krylov, adr)"
+            )),
+        }
+    }
+
+    /// The word that names it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ElasticSolver::Adr => "adr",
+            ElasticSolver::Implicit => "implicit",
+            ElasticSolver::NewtonKrylov => "newton_krylov",
+        }
+    }
+}
+
+/// The cases listed in `dir/suite.toml`, in its order, at `level`; the elastic ones by
+/// `solver`. A case file the list leaves out is refused, not skipped.
+pub fn load_suite(dir: &Path, level: Level, solver: ElasticSolver) -> Result<Vec<Case>, String> {
     let path = dir.join("suite.toml");
     let text = std::fs::read_to_string(&path).map_err(|e| {
         format!(
@@ -88,13 +121,13 @@ pub fn load_suite(dir: &Path, level: Level, implicit: bool) -> Result<Vec<Case>,
     suite
         .cases
         .iter()
-        .map(|name| load(&dir.join(format!("{name}.toml")), level, implicit))
+        .map(|name| load(&dir.join(format!("{name}.toml")), level, solver))
         .collect()
 }
 
 /// One case file at `level`.
-pub fn load(path: &Path, level: Level, implicit: bool) -> Result<Case, String> {
-    load_with(path, level, implicit, None)
+pub fn load(path: &Path, level: Level, solver: ElasticSolver) -> Result<Case, String> {
+    load_with(path, level, solver, None)
 }
 
 /// A deck edit made after the level's (`sweep` resizes the cantilever with one).
@@ -104,7 +137,7 @@ pub type Edit<'a> = &'a dyn Fn(&mut toml::Table) -> Result<(), String>;
 pub fn load_with(
     path: &Path,
     level: Level,
-    implicit: bool,
+    solver: ElasticSolver,
     edit: Option<Edit>,
 ) -> Result<Case, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -144,7 +177,7 @@ pub fn load_with(
             ));
         }
     }
-    if implicit && v.kind == Kind::Elastic {
+    if solver != ElasticSolver::Adr && v.kind == Kind::Elastic {
         let patch = v.implicit.as_ref().ok_or_else(|| {
             format!(
                 "{}: no [validation.implicit] to solve it by",
@@ -153,6 +186,11 @@ pub fn load_with(
         })?;
         merge(&mut deck, patch, "")
             .map_err(|e| format!("{}: [validation.implicit]: {e}", path.display()))?;
+        if solver == ElasticSolver::NewtonKrylov {
+            if let Some(toml::Value::Table(t)) = deck.get_mut("solver") {
+                t.insert("kind".into(), toml::Value::String("newton_krylov".into()));
+            }
+        }
         changed = true;
     }
     if let Some(edit) = edit {

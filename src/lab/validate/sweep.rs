@@ -79,7 +79,7 @@ pub struct SweepPoint {
 
 /// `pdq validate --sweep`: the elastic cantilever of each model (`cases/cantilever_MODEL.toml`)
 /// at each section resolution (lattice planes across the section, odd) and horizon ratio m,
-/// solved by each solver ("implicit", "adr"); the error against Timoshenko and the run time of
+/// solved by each solver ("implicit", "newton_krylov", "adr"); the error against Timoshenko and the run time of
 /// each, a table and a PNG plot of error against run time. Runs one at a time on one thread.
 pub fn sweep(
     output: &Path,
@@ -100,20 +100,13 @@ pub fn sweep(
             }
             for &m in ms {
                 for solver in solvers {
-                    let solver: &'static str = match solver.as_str() {
-                        "implicit" => "implicit",
-                        "adr" => "adr",
-                        other => {
-                            return Err(format!(
-                                "--solvers: unknown solver '{other}' (use implicit, adr)"
-                            ))
-                        }
-                    };
+                    let how = case_file::ElasticSolver::named(solver)
+                        .map_err(|e| format!("--solvers: {e}"))?;
+                    let solver = how.name();
                     let file = cases.join(format!("cantilever_{model}.toml"));
                     let edit = resize(c, m);
-                    let implicit = solver == "implicit";
                     let mut case =
-                        case_file::load_with(&file, Level::Quick, implicit, Some(&edit as Edit))?;
+                        case_file::load_with(&file, Level::Quick, how, Some(&edit as Edit))?;
                     if !(m == 3.0 && [7, 13].contains(&c)) {
                         case.name = format!("cantilever_{model}_{c}planes_m{m}");
                     }
