@@ -146,7 +146,7 @@ struct ValidateArgs {
     #[arg(long, default_value = "out/validate")]
     output: PathBuf,
     /// Threads per explicit or ADR case (default: the cores available; the implicit solve
-    /// runs on one).
+    /// runs on one); with --sweep, the procCubes of each sweep run (default 1).
     #[arg(long)]
     threads: Option<usize>,
     /// Instead of the cases: ADR against an explicit load ramp on the LPS cantilever
@@ -374,6 +374,7 @@ fn validate(a: ValidateArgs) -> Result<(), String> {
             &a.planes,
             &a.m,
             &a.solvers,
+            a.threads.unwrap_or(1),
         )?;
         print!("{s}");
         return Ok(());

@@ -2,7 +2,7 @@
 //! strain, the virial stress at its centre particle (whose family and neighbours' families are
 //! whole), and the E and ν that stress implies, against the E and ν the deck gives.
 
-use pdq::engine::analysis::{deform_affinely, virial_stress, young_poisson, CubicConstants};
+use pdq::engine::analysis::{cubic_constants_at_centre, young_poisson, CubicConstants};
 use pdq::input::{deck, setup};
 use pdq::model::Model;
 
@@ -35,31 +35,11 @@ progress = false
     )
 }
 
-/// The cubic constants at the centre of a block: stress under uniaxial strain along x and
-/// under shear in xy, at the centre particle.
+/// The cubic constants at the centre of a block (`cubic_constants_at_centre`).
 pub fn constants<M: Model>(text: &str) -> CubicConstants {
     let scene = deck::parse(text, "block.toml", "block").unwrap_or_else(|e| panic!("{e}"));
     let mut s = setup::build_as::<M>(&scene).unwrap_or_else(|e| panic!("{e}"));
-    let p = &s.sim.particles;
-    let (lo, hi) = p.x0.iter().fold((f64::INFINITY, 0.0f64), |(l, h), x| {
-        (l.min(x[0]), h.max(x[0]))
-    });
-    let mid = [0.5 * (lo + hi); 3];
-    let centre = (0..p.len())
-        .min_by(|&a, &b| {
-            let d = |i: usize| (0..3).map(|k| (p.x0[i][k] - mid[k]).powi(2)).sum::<f64>();
-            d(a).total_cmp(&d(b))
-        })
-        .unwrap();
-    let mut stress = |h: [[f64; 3]; 3]| {
-        deform_affinely(&mut s.sim.particles, h, mid);
-        s.sim.compute_forces();
-        virial_stress(&s.sim.model, &s.sim.particles, &s.sim.bonds, centre)
-    };
-    let (eps, gamma) = (1e-4, 1e-4);
-    let uniaxial = stress([[eps, 0.0, 0.0], [0.0; 3], [0.0; 3]]);
-    let shear = stress([[0.0, 0.5 * gamma, 0.0], [0.5 * gamma, 0.0, 0.0], [0.0; 3]]);
-    CubicConstants::from_tests(&uniaxial, eps, &shear, gamma)
+    cubic_constants_at_centre(&mut s.sim).expect("the block has particles")
 }
 
 /// E and ν of the isotropic (orientation-averaged) solid the block stands for.

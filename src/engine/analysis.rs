@@ -3,6 +3,7 @@
 
 use crate::engine::bonds::BondList;
 use crate::engine::particles::Particles;
+use crate::engine::simulation::Simulation;
 use crate::model::attributes::Attributes;
 use crate::model::Model;
 
@@ -54,6 +55,34 @@ pub fn virial_stress<M: Model>(
     s
 }
 
+/// The cubic constants at the particle nearest the centre of a block whose centre particle's
+/// family (and its neighbours' families) is whole: the virial stress there under uniaxial
+/// strain 10⁻⁴ along x and under engineering shear 10⁻⁴ in xy, each imposed affinely.
+/// `None` for a simulation without particles.
+pub fn cubic_constants_at_centre<M: Model>(sim: &mut Simulation<M>) -> Option<CubicConstants> {
+    let p = &sim.particles;
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for x in &p.x0 {
+        for k in 0..3 {
+            lo[k] = lo[k].min(x[k]);
+            hi[k] = hi[k].max(x[k]);
+        }
+    }
+    let mid = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+    let distance = |i: usize| (0..3).map(|k| (p.x0[i][k] - mid[k]).powi(2)).sum::<f64>();
+    let centre = (0..p.len()).min_by(|&a, &b| distance(a).total_cmp(&distance(b)))?;
+    let mut stress = |h: [[f64; 3]; 3]| {
+        deform_affinely(&mut sim.particles, h, mid);
+        sim.compute_forces();
+        virial_stress(&sim.model, &sim.particles, &sim.bonds, centre)
+    };
+    let (eps, gamma) = (1e-4, 1e-4);
+    let uniaxial = stress([[eps, 0.0, 0.0], [0.0; 3], [0.0; 3]]);
+    let shear = stress([[0.0, 0.5 * gamma, 0.0], [0.5 * gamma, 0.0, 0.0], [0.0; 3]]);
+    Some(CubicConstants::from_tests(&uniaxial, eps, &shear, gamma))
+}
+
 /// The three elastic constants of a solid with the lattice's cubic symmetry.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CubicConstants {
@@ -86,6 +115,12 @@ impl CubicConstants {
             (self.c11 + 4.0 * self.c12 - 2.0 * self.c44) / 5.0,
             (self.c11 - self.c12 + 3.0 * self.c44) / 5.0,
         )
+    }
+
+    /// Young's modulus along a cube axis ([100]): 1/S11 = (C11 − C12)(C11 + 2C12)/(C11 + C12),
+    /// what a beam along a lattice axis bends with.
+    pub fn youngs_modulus_100(&self) -> f64 {
+        (self.c11 - self.c12) * (self.c11 + 2.0 * self.c12) / (self.c11 + self.c12)
     }
 
     /// Zener's anisotropy ratio 2C44/(C11 − C12): 1 for an isotropic solid.

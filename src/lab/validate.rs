@@ -18,6 +18,7 @@ use std::time::Instant;
 
 pub mod case_file;
 pub mod formulas;
+pub mod lattice;
 pub mod measures;
 mod sweep;
 
@@ -89,6 +90,9 @@ pub struct Case {
     pub thesis: Option<f64>,
     /// Where the reference comes from.
     pub formula: String,
+    /// The formula the reference is computed by, to compute it again with other moduli
+    /// (`None` for a case made in code with a fixed reference).
+    pub formula_of: Option<formulas::Formula>,
     pub tolerance_percent: f64,
     /// The regression band at this level (required of strength cases at `--quick`).
     pub band: Option<Band>,

@@ -220,6 +220,7 @@ pub fn load_with(
         reference: reference.value,
         thesis: v.thesis,
         formula,
+        formula_of: Some(v.reference),
         tolerance_percent: tolerance,
         band,
         deck: text,

@@ -61,8 +61,27 @@ pub struct Reference {
     pub curve: Curve,
 }
 
+/// Elastic moduli a beam formula uses in place of the deck's isotropic E and G: the lattice's
+/// own along the beam's axis (`lattice.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Moduli {
+    /// Young's modulus along the beam's axis.
+    pub youngs: f64,
+    /// Shear modulus of the planes through the axis.
+    pub shear: f64,
+}
+
 impl Formula {
     pub fn evaluate(&self, scene: &Scene) -> Result<Reference, String> {
+        self.evaluate_with(scene, None)
+    }
+
+    /// The reference with the beam's moduli `moduli` where given (the beam formulas only).
+    pub fn evaluate_with(
+        &self,
+        scene: &Scene,
+        moduli: Option<Moduli>,
+    ) -> Result<Reference, String> {
         match self {
             Formula::OrangunJirsaBreen {} => return splice::reference(scene),
             Formula::AciPrestressedCracking {
@@ -72,7 +91,10 @@ impl Formula {
             } => return prestressed::reference(scene, supports, load, weight),
             _ => {}
         }
-        let beam = Beam::of(scene)?;
+        let beam = Beam {
+            moduli,
+            ..Beam::of(scene)?
+        };
         match self {
             Formula::TimoshenkoCantilever { clamp, load } => {
                 timoshenko_cantilever(scene, &beam, clamp, load)
@@ -142,6 +164,8 @@ struct Beam<'a> {
     width: f64,
     depth: f64,
     material: &'a Material,
+    /// In place of the material's isotropic E and G.
+    moduli: Option<Moduli>,
 }
 
 impl<'a> Beam<'a> {
@@ -162,6 +186,7 @@ impl<'a> Beam<'a> {
             width: max[1] - min[1],
             depth: max[2] - min[2],
             material: &scene.materials[material as usize],
+            moduli: None,
         })
     }
 
@@ -175,6 +200,9 @@ impl<'a> Beam<'a> {
     }
 
     fn youngs_modulus(&self) -> Result<f64, String> {
+        if let Some(m) = self.moduli {
+            return Ok(m.youngs);
+        }
         let e = self.material.quantity("youngs_modulus", Dimension::STRESS);
         e.map_err(|e| e.to_string())?.ok_or_else(|| {
             format!(
@@ -192,7 +220,10 @@ impl<'a> Beam<'a> {
 
     /// κGA with κ = 5/6.
     fn shear_stiffness(&self) -> Result<f64, String> {
-        let g = self.youngs_modulus()? / (2.0 * (1.0 + self.poisson_ratio()?));
+        let g = match self.moduli {
+            Some(m) => m.shear,
+            None => self.youngs_modulus()? / (2.0 * (1.0 + self.poisson_ratio()?)),
+        };
         Ok(5.0 / 6.0 * g * self.width * self.depth)
     }
 
@@ -215,6 +246,12 @@ impl<'a> Beam<'a> {
     fn describe(&self, scene: &Scene) -> Result<String, String> {
         let length = scene.units.label(Dim::new(0, 1, 0));
         let stress = scene.units.label(Dim::new(1, -1, -2));
+        if let Some(m) = self.moduli {
+            return Ok(format!(
+                "h = {:.3} {length}, the lattice's E along the axis {:.4e} {stress} and G = C44 {:.4e} {stress}",
+                self.depth, m.youngs, m.shear
+            ));
+        }
         Ok(format!(
             "h = {:.3} {length}, E = {:.4e} {stress}, ν = {}",
             self.depth,

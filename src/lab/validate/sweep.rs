@@ -72,15 +72,23 @@ pub struct SweepPoint {
     pub m: f64,
     pub solver: &'static str,
     pub particles: usize,
+    /// Against Timoshenko with the deck's isotropic E and ν.
     pub error_percent: f64,
+    /// Against Timoshenko with the lattice's own E along the axis and G = C44.
+    pub lattice_error_percent: f64,
+    /// The lattice's E along [100] over the deck's E.
+    pub lattice_youngs_ratio: f64,
+    pub converged: Option<bool>,
     pub seconds: f64,
     pub force_evaluations: u64,
 }
 
 /// `pdq validate --sweep`: the elastic cantilever of each model (`cases/cantilever_MODEL.toml`)
 /// at each section resolution (lattice planes across the section, odd) and horizon ratio m,
-/// solved by each solver ("implicit", "newton_krylov", "adr"); the error against Timoshenko and the run time of
-/// each, a table and a PNG plot of error against run time. Runs one at a time on one thread.
+/// solved by each solver ("implicit", "newton_krylov", "adr"); the error against Timoshenko
+/// with the deck's isotropic moduli and with the lattice's own along the beam's axis
+/// (`lattice.rs`), the run time of each, a table and a PNG plot of error against run time.
+/// Runs one at a time, each on `threads` procCubes.
 pub fn sweep(
     output: &Path,
     cases: &Path,
@@ -88,6 +96,7 @@ pub fn sweep(
     cells: &[usize],
     ms: &[f64],
     solvers: &[String],
+    threads: usize,
 ) -> Result<String, String> {
     std::fs::create_dir_all(output).map_err(|e| format!("{}: {e}", output.display()))?;
     let mut points = Vec::new();
@@ -113,9 +122,11 @@ pub fn sweep(
                     case.plot = None;
                     let dir = output.join(format!("{}_{solver}", case.name));
                     eprintln!("sweep      {} by {solver} ...", case.name);
-                    let o = run_case(&case, &dir, 1)?;
+                    let lattice = lattice_reference(&case)?;
+                    let o = run_case(&case, &dir, threads)?;
+                    let lattice_error = 100.0 * (o.measured - lattice.value) / lattice.value;
                     eprintln!(
-                        "           {:+.2} % in {:.1} s ({} particles)",
+                        "           {:+.2} % (lattice moduli {lattice_error:+.2} %) in {:.1} s ({} particles)",
                         o.error_percent, o.seconds, o.particles
                     );
                     let _ = std::fs::remove_dir_all(&dir);
@@ -126,6 +137,9 @@ pub fn sweep(
                         solver,
                         particles: o.particles,
                         error_percent: o.error_percent,
+                        lattice_error_percent: lattice_error,
+                        lattice_youngs_ratio: lattice.youngs_ratio,
+                        converged: o.converged,
                         seconds: o.seconds,
                         force_evaluations: o.force_evaluations,
                     });
@@ -136,19 +150,65 @@ pub fn sweep(
     report_sweep(output, &points)
 }
 
+/// A cantilever's reference with the lattice's own moduli.
+struct LatticeReference {
+    value: f64,
+    /// E along [100] over the deck's E.
+    youngs_ratio: f64,
+}
+
+/// The reference of `case` with its lattice's E along [100] and G = C44 in place of the deck's
+/// isotropic E and G (the beam lies along x, a lattice axis).
+fn lattice_reference(case: &super::Case) -> Result<LatticeReference, String> {
+    let formula = case
+        .formula_of
+        .as_ref()
+        .ok_or_else(|| format!("case {} has no formula to evaluate", case.name))?;
+    let table: toml::Table = toml::from_str(&case.deck).map_err(|e| e.to_string())?;
+    let scene = deck::parse(&case.deck, &format!("{}.toml", case.name), &case.name)
+        .map_err(|e| format!("case {}: {e}", case.name))?;
+    let c = super::lattice::constants_of(&table, &scene)?;
+    let moduli = super::formulas::Moduli {
+        youngs: c.youngs_modulus_100(),
+        shear: c.c44,
+    };
+    let value = formula.evaluate_with(&scene, Some(moduli))?.value;
+    // The cantilevers have one material.
+    let e = scene
+        .materials
+        .first()
+        .and_then(|m| {
+            m.quantity("youngs_modulus", crate::model::Dimension::STRESS)
+                .ok()
+        })
+        .flatten()
+        .ok_or("the cantilever's material has no youngs_modulus")?;
+    Ok(LatticeReference {
+        value,
+        youngs_ratio: moduli.youngs / e,
+    })
+}
+
 /// The sweep's table, `sweep.md` and `sweep.png` (|error| against log run time).
 fn report_sweep(output: &Path, points: &[SweepPoint]) -> Result<String, String> {
-    let mut t = String::from("| model | planes across | m | solver | particles | error % | force evaluations | run time s |\n|---|---|---|---|---|---|---|---|\n");
+    let mut t = String::from("| model | planes across | m | solver | particles | error % (isotropic E, ν) | error % (lattice E[100], C44) | lattice E[100]/E | converged | force evaluations | run time s |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     for p in points {
+        let converged = match p.converged {
+            Some(true) => "yes",
+            Some(false) => "**no**",
+            None => "-",
+        };
         let _ = writeln!(
             t,
-            "| {} | {} | {} | {} | {} | {:+.2} | {} | {:.1} |",
+            "| {} | {} | {} | {} | {} | {:+.2} | {:+.2} | {:.4} | {converged} | {} | {:.1} |",
             p.model,
             p.cells,
             p.m,
             p.solver,
             p.particles,
             p.error_percent,
+            p.lattice_error_percent,
+            p.lattice_youngs_ratio,
             p.force_evaluations,
             p.seconds
         );
