@@ -180,6 +180,16 @@ struct ValidateArgs {
     /// Sweep: solvers, comma-separated (implicit, newton_krylov, adr).
     #[arg(long, value_delimiter = ',', default_value = "implicit")]
     solvers: Vec<String>,
+    /// Instead of the cases: each elastic beam case's formula against 3D linear elasticity
+    /// by finite elements on the case's geometry (fe_check.md).
+    #[arg(long)]
+    fe_check: bool,
+    /// --fe-check: element orders, comma-separated, each a solve.
+    #[arg(long, value_delimiter = ',', default_value = "2,3")]
+    fe_orders: Vec<usize>,
+    /// --fe-check: elements across the beam's depth.
+    #[arg(long, default_value_t = 4)]
+    fe_elements: usize,
 }
 
 #[derive(Args)]
@@ -379,6 +389,25 @@ fn validate(a: ValidateArgs) -> Result<(), String> {
         print!("{s}");
         return Ok(());
     }
+    let level = if a.full {
+        pdq::lab::validate::Level::Full
+    } else {
+        pdq::lab::validate::Level::Quick
+    };
+    if a.fe_check {
+        let (report, _) = pdq::lab::validate::fe_check::fe_check(
+            &pdq::lab::validate::fe_check::FeCheckOptions {
+                cases: a.case_dir,
+                level,
+                only: a.cases,
+                output: a.output,
+                orders: a.fe_orders,
+                elements_across: a.fe_elements,
+            },
+        )?;
+        print!("{report}");
+        return Ok(());
+    }
     if a.compare_adr {
         let s = pdq::lab::validate::compare_adr(&a.output, &a.case_dir, threads, a.ramp_periods)?;
         print!("{s}");
@@ -390,11 +419,7 @@ fn validate(a: ValidateArgs) -> Result<(), String> {
             Some(word) => pdq::lab::validate::ElasticSolver::named(word)?,
             None => pdq::lab::validate::ElasticSolver::NewtonKrylov,
         },
-        level: if a.full {
-            pdq::lab::validate::Level::Full
-        } else {
-            pdq::lab::validate::Level::Quick
-        },
+        level,
         only: a.cases,
         output: a.output,
         threads,

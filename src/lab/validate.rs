@@ -17,6 +17,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 pub mod case_file;
+mod elasticity_fe;
+pub mod fe_check;
 pub mod formulas;
 pub mod lattice;
 pub mod measures;
@@ -93,6 +95,8 @@ pub struct Case {
     /// The formula the reference is computed by, to compute it again with other moduli
     /// (`None` for a case made in code with a fixed reference).
     pub formula_of: Option<formulas::Formula>,
+    /// How the measured value is read, to read it the same way elsewhere (`fe_check.rs`).
+    pub measure_of: Option<measures::Measure>,
     pub tolerance_percent: f64,
     /// The regression band at this level (required of strength cases at `--quick`).
     pub band: Option<Band>,

@@ -221,6 +221,7 @@ pub fn load_with(
         thesis: v.thesis,
         formula,
         formula_of: Some(v.reference),
+        measure_of: Some(v.measure),
         tolerance_percent: tolerance,
         band,
         deck: text,

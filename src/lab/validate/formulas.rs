@@ -170,22 +170,12 @@ struct Beam<'a> {
 
 impl<'a> Beam<'a> {
     fn of(scene: &'a Scene) -> Result<Beam<'a>, String> {
-        let (min, max, material) = scene
-            .ops
-            .iter()
-            .find_map(|op| match &op.item {
-                Op::Add {
-                    shape: Shape::Box { min, max },
-                    material,
-                } => Some((*min, *max, *material)),
-                _ => None,
-            })
-            .ok_or("the reference formulas of beams read the deck's first box, and it has none")?;
+        let (min, max, material) = first_box(scene)?;
         Ok(Beam {
             length: max[0] - min[0],
             width: max[1] - min[1],
             depth: max[2] - min[2],
-            material: &scene.materials[material as usize],
+            material: &scene.materials[material],
             moduli: None,
         })
     }
@@ -258,6 +248,60 @@ impl<'a> Beam<'a> {
             self.youngs_modulus()?,
             self.poisson_ratio()?
         ))
+    }
+}
+
+/// The deck's first box, its corners and its material's index: the beam.
+fn first_box(scene: &Scene) -> Result<([f64; 3], [f64; 3], usize), String> {
+    scene
+        .ops
+        .iter()
+        .find_map(|op| match &op.item {
+            Op::Add {
+                shape: Shape::Box { min, max },
+                material,
+            } => Some((*min, *max, *material as usize)),
+            _ => None,
+        })
+        .ok_or_else(|| {
+            "the reference formulas of beams read the deck's first box, and it has none".into()
+        })
+}
+
+/// A beam's body and the isotropic moduli its formulas use (`fe_check.rs`).
+pub(super) struct BeamBody {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    pub youngs: f64,
+    pub poisson: f64,
+}
+
+pub(super) fn beam_body(scene: &Scene) -> Result<BeamBody, String> {
+    let (min, max, _) = first_box(scene)?;
+    let beam = Beam::of(scene)?;
+    Ok(BeamBody {
+        min,
+        max,
+        youngs: beam.youngs_modulus()?,
+        poisson: beam.poisson_ratio()?,
+    })
+}
+
+/// A slab or box region as a box, a slab spanning the body `lo`–`hi` across its axis.
+pub(super) fn region_box(
+    region: &Region,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    what: &str,
+) -> Result<([f64; 3], [f64; 3]), String> {
+    match region {
+        Region::Shape(Shape::Slab { axis, from, to }) => {
+            let (mut a, mut b) = (lo, hi);
+            (a[*axis], b[*axis]) = (*from, *to);
+            Ok((a, b))
+        }
+        Region::Shape(Shape::Box { min, max }) => Ok((*min, *max)),
+        _ => Err(format!("{what}: a slab or a box is needed")),
     }
 }
 
@@ -354,7 +398,7 @@ fn aci_shear(scene: &Scene, beam: &Beam) -> Result<(f64, String), String> {
     Ok((2.0 * fc.sqrt() * beam.width * d, words))
 }
 
-fn boundary_region<'s>(scene: &'s Scene, name: &str) -> Result<&'s Region, String> {
+pub(super) fn boundary_region<'s>(scene: &'s Scene, name: &str) -> Result<&'s Region, String> {
     scene
         .boundaries
         .iter()
@@ -365,7 +409,7 @@ fn boundary_region<'s>(scene: &'s Scene, name: &str) -> Result<&'s Region, Strin
         })
 }
 
-fn load_region<'s>(scene: &'s Scene, name: &str) -> Result<&'s Region, String> {
+pub(super) fn load_region<'s>(scene: &'s Scene, name: &str) -> Result<&'s Region, String> {
     scene
         .loads
         .iter()
@@ -388,11 +432,11 @@ fn x_extent(region: &Region, what: &str) -> Result<(f64, f64), String> {
 }
 
 /// Where the clamp ends: the beam starts there.
-fn clamp_face(scene: &Scene, clamp: &str) -> Result<f64, String> {
+pub(super) fn clamp_face(scene: &Scene, clamp: &str) -> Result<f64, String> {
     Ok(x_extent(boundary_region(scene, clamp)?, clamp)?.1)
 }
 
-fn region_centre(scene: &Scene, support: &str) -> Result<f64, String> {
+pub(super) fn region_centre(scene: &Scene, support: &str) -> Result<f64, String> {
     let (a, b) = x_extent(boundary_region(scene, support)?, support)?;
     Ok(0.5 * (a + b))
 }
@@ -412,7 +456,7 @@ fn loaded_length(scene: &Scene, load: &str) -> Result<f64, String> {
     Ok(b - a)
 }
 
-fn total_force(scene: &Scene, load: &str) -> Result<[f64; 3], String> {
+pub(super) fn total_force(scene: &Scene, load: &str) -> Result<[f64; 3], String> {
     match scene.loads.iter().find(|l| l.name == load).map(|l| l.kind) {
         Some(LoadKind::Total(f)) => Ok(f),
         Some(_) => Err(format!(
