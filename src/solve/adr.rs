@@ -17,9 +17,9 @@
 //! The fictitious mass. The iterations needed grow as √(λ_max/λ_min) of M⁻¹K, and the pseudo
 //! time step 1 is stable while λ_max(M⁻¹K) < 4. The book takes λ_i = ¼ Σ_j |K_ij| (a Gershgorin
 //! bound, so λ_max ≤ 4 for any stiffness) times a safety factor 5. On a peridynamic lattice
-//! that bound is loose: for PMB at m = 3 the stiffest wave of the infinite lattice is a quarter
-//! of it (Bloch analysis), and on the suite's beams the book's masses are 6–7× heavier than
-//! stability needs, which costs about √6.6 in iterations. PDQ keeps the Gershgorin shape,
+//! that bound is loose: on the suite's quick cantilevers the stiffest mode is 0.66 of it for
+//! PMB and 0.63 for LPS (the Lanczos estimate below), so the book's masses are 6–7× heavier
+//! than stability needs, which costs about √6.6 in iterations. PDQ keeps the Gershgorin shape,
 //! b_i = V_i Σ_j V_j C_ij per DOF with C_ij from [`Model::relaxation_stiffness`] (a diagonal
 //! preconditioner), and scales it by a measured λ_max(B⁻¹K): a Lanczos run of
 //! [`crate::engine::spectrum::LANCZOS_STEPS`] force evaluations on the undeformed scene, with K applied as force
