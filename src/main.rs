@@ -180,6 +180,13 @@ struct ValidateArgs {
     /// Sweep: solvers, comma-separated (implicit, newton_krylov, adr).
     #[arg(long, value_delimiter = ',', default_value = "implicit")]
     solvers: Vec<String>,
+    /// Checkpoint each case every T minutes of wall time (long --full runs).
+    #[arg(long, value_name = "T")]
+    checkpoint_minutes: Option<f64>,
+    /// Resume each case from the newest checkpoint in its output directory, where there is
+    /// one (a run stopped by SIGTERM, Ctrl-C or a time limit).
+    #[arg(long)]
+    resume: bool,
     /// Instead of the cases: each elastic beam case's formula against 3D linear elasticity
     /// by finite elements on the case's geometry (fe_check.md).
     #[arg(long)]
@@ -423,6 +430,16 @@ fn validate(a: ValidateArgs) -> Result<(), String> {
         only: a.cases,
         output: a.output,
         threads,
+        long: pdq::lab::validate::LongRun {
+            checkpoint_minutes: match a.checkpoint_minutes {
+                Some(t) if !(t > 0.0 && t.is_finite()) => {
+                    return Err(format!("--checkpoint-minutes must be > 0 (got {t})"))
+                }
+                Some(t) => t,
+                None => 0.0,
+            },
+            resume: a.resume,
+        },
     })?;
     print!("{table}");
     if failures.is_empty() {

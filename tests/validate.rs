@@ -17,6 +17,7 @@ fn an_unknown_case_is_refused_with_the_list() {
         only: vec!["cantilever_steel".into()],
         output: out("unknown"),
         threads: 1,
+        long: Default::default(),
     })
     .expect_err("no such case");
     assert!(
@@ -261,6 +262,14 @@ fn the_fast_lap_splice_pulls_out() {
     .into_iter()
     .find(|c| c.name == "lap_splice_fast")
     .expect("the case exists");
+    let case = Case {
+        deck: case.deck.replacen(
+            "[output]\n",
+            "[output]\ncheckpoint_every = 150\ncheckpoint_keep = 10\n",
+            1,
+        ),
+        ..case
+    };
     let dir = out("lap");
     let o = validate::run_case(&case, &dir.join(&case.name), 1).expect("the case runs");
     assert!(o.measured.is_finite() && o.measured > 0.0, "{}", o.measured);
@@ -276,6 +285,31 @@ fn the_fast_lap_splice_pulls_out() {
         o.measured
     );
     assert!(o.views.as_deref().is_some_and(Path::exists));
+    // Stopped after its first checkpoint and resumed (`pdq validate --resume`): the same peak,
+    // bit for bit, read from the history the restart continued.
+    let checkpoints = dir.join(&case.name).join("checkpoints");
+    let mut files: Vec<_> = std::fs::read_dir(&checkpoints)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .collect();
+    files.sort();
+    assert!(files.len() >= 3, "checkpoints: {files:?}");
+    files[1..]
+        .iter()
+        .for_each(|f| std::fs::remove_file(f).unwrap());
+    let resume = validate::LongRun {
+        checkpoint_minutes: 0.0,
+        resume: true,
+    };
+    let again = validate::run_case_long(&case, &dir.join(&case.name), 1, resume).unwrap();
+    assert_eq!(
+        again.measured.to_bits(),
+        o.measured.to_bits(),
+        "{} against {}",
+        again.measured,
+        o.measured
+    );
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -133,10 +133,46 @@ pub struct Outcome {
     pub views: Option<PathBuf>,
 }
 
+/// How a long case run survives being stopped: checkpoints on the clock, and a resume from
+/// the newest one in the case's directory.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LongRun {
+    /// A checkpoint every so many minutes of wall time (0: the deck's own setting).
+    pub checkpoint_minutes: f64,
+    /// Resume from the newest checkpoint in the case's directory, where there is one.
+    pub resume: bool,
+}
+
 /// Runs `case` with its output in `dir`.
 pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, String> {
-    let scene = deck::parse(&case.deck, &format!("{}.toml", case.name), &case.name)
+    run_case_long(case, dir, threads, LongRun::default())
+}
+
+/// Runs `case` with its output in `dir`, checkpointed and resumed as `long` says. The run
+/// time of a resumed case is that of this invocation only.
+pub fn run_case_long(
+    case: &Case,
+    dir: &Path,
+    threads: usize,
+    long: LongRun,
+) -> Result<Outcome, String> {
+    let mut scene = deck::parse(&case.deck, &format!("{}.toml", case.name), &case.name)
         .map_err(|e| format!("case {}: {e}", case.name))?;
+    if long.checkpoint_minutes > 0.0 {
+        scene.output.checkpoint_minutes = long.checkpoint_minutes;
+    }
+    let checkpoints = dir.join("checkpoints");
+    let has_checkpoint = std::fs::read_dir(&checkpoints)
+        .map(|mut d| d.next().is_some())
+        .unwrap_or(false);
+    let restart = (long.resume && has_checkpoint).then_some(checkpoints);
+    if long.resume && restart.is_none() {
+        eprintln!(
+            "case {}: no checkpoint in {} to resume from; starting",
+            case.name,
+            dir.display()
+        );
+    }
     // The deck beside its run directory, so that `pdq run` repeats or varies the case.
     // (Not `with_extension`: a sweep's run names hold the dot of a fractional m.)
     let mut deck_name = dir.file_name().unwrap_or_default().to_os_string();
@@ -154,6 +190,7 @@ pub fn run_case(case: &Case, dir: &Path, threads: usize) -> Result<Outcome, Stri
             output: Some(dir.to_path_buf()),
             quiet: true,
             threads: Some(threads),
+            restart,
             ..Default::default()
         },
     )
@@ -358,6 +395,7 @@ pub struct ValidateOptions {
     pub only: Vec<String>,
     pub output: PathBuf,
     pub threads: usize,
+    pub long: LongRun,
 }
 
 /// The cases of a level, in report order: the files that `dir/suite.toml` lists (the elastic
@@ -414,7 +452,7 @@ fn run_chosen(chosen: &[&Case], opts: &ValidateOptions) -> Result<Vec<Outcome>, 
     };
     let run_one = |case: &Case, threads: usize| -> Result<Outcome, String> {
         eprintln!("case       {} ...", case.name);
-        let o = run_case(case, &opts.output.join(&case.name), threads)?;
+        let o = run_case_long(case, &opts.output.join(&case.name), threads, opts.long)?;
         eprintln!(
             "           {}: {} = {:.5e} {} against {:.5e} ({:+.2} %) in {:.1} s",
             o.name, o.quantity, o.measured, o.unit, o.reference, o.error_percent, o.seconds
