@@ -135,8 +135,12 @@ struct ValidateArgs {
     #[arg(long, conflicts_with = "full")]
     quick: bool,
     /// The finer resolution.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "thesis")]
     full: bool,
+    /// The thesis's resolution (the lap splices at 0.1 in, the girder and the reinforced
+    /// beams at 1 in): hours on 2 cores; with --checkpoint-minutes and --resume.
+    #[arg(long, conflicts_with = "quick")]
+    thesis: bool,
     /// Cases to run (all when none is named).
     cases: Vec<String>,
     /// The directory of the case files (NAME.toml and suite.toml; validation/README.md).
@@ -396,7 +400,9 @@ fn validate(a: ValidateArgs) -> Result<(), String> {
         print!("{s}");
         return Ok(());
     }
-    let level = if a.full {
+    let level = if a.thesis {
+        pdq::lab::validate::Level::Thesis
+    } else if a.full {
         pdq::lab::validate::Level::Full
     } else {
         pdq::lab::validate::Level::Quick

@@ -210,6 +210,7 @@ fn every_case_deck_parses() {
         (Level::Full, Adr),
         (Level::Full, Implicit),
         (Level::Full, NewtonKrylov),
+        (Level::Thesis, Adr),
     ] {
         for case in validate::cases(Path::new("validation"), level, solver).unwrap() {
             let name = format!("{}.toml", case.name);
@@ -227,6 +228,9 @@ fn every_case_deck_parses() {
                 0
             };
             assert_eq!(case.deck.matches("[[bar]]").count(), bars, "{}", case.name);
+            if level == Level::Thesis && case.name.starts_with("lap_splice_") {
+                assert!(case.deck.contains("spacing = \"0.1 in\""), "{}", case.name);
+            }
             let strands = if case.name == "prestressed_girder" {
                 3
             } else {

@@ -33,8 +33,33 @@ pub use sweep::{compare_adr, sweep, SweepPoint};
 pub enum Level {
     /// Coarse versions of every case: minutes on 2 cores, run in CI.
     Quick,
-    /// Finer lattices (the thesis's resolution where the case is one of its problems).
+    /// Finer lattices (`[validation.full]`).
     Full,
+    /// The thesis's resolution (`[validation.thesis_resolution]`; the full level where a case has none,
+    /// its full level being the thesis's already): hours on 2 cores, run outside CI.
+    Thesis,
+}
+
+impl Level {
+    /// The command-line flag that chooses it.
+    pub fn flag(self) -> &'static str {
+        match self {
+            Level::Quick => "--quick",
+            Level::Full => "--full",
+            Level::Thesis => "--thesis",
+        }
+    }
+
+    /// The case file's table of the level.
+    pub fn table(self) -> &'static str {
+        match self {
+            Level::Quick => "[validation]",
+            Level::Full => "[validation.full]",
+            Level::Thesis => {
+                "[validation.thesis_resolution] (or [validation.full] where it has none)"
+            }
+        }
+    }
 }
 
 /// Elastic cases must meet their tolerance against the formula; strength cases report
@@ -295,10 +320,7 @@ impl Outcome {
             ));
         }
         let file = format!("{}.toml (the case directory)", self.name);
-        let table = match level {
-            Level::Quick => "[validation]",
-            Level::Full => "[validation.full]",
-        };
+        let table = level.table();
         match self.band {
             Some(b) if !b.holds(self.measured) => why.push(format!(
                 "{}: {:.5e} left its regression band {:.5e} ± {} % ({:+.2} %); if the change is meant, re-measure it: {table} regression = {{ value = {:.5e}, percent = {} }} in {file}",
@@ -483,10 +505,7 @@ fn write_report(opts: &ValidateOptions, t: &str, outcomes: &[Outcome]) -> Result
     let _ = writeln!(
         report,
         "# PDQ validation ({}, solved by {})\n",
-        match opts.level {
-            Level::Quick => "--quick",
-            Level::Full => "--full",
-        },
+        opts.level.flag(),
         match opts.solver {
             ElasticSolver::Implicit => "the implicit solve",
             ElasticSolver::NewtonKrylov => "Newton–Krylov",

@@ -32,6 +32,8 @@ struct Validation {
     regression: Option<Band>,
     /// What `--full` changes: the deck (merged over this one) and the table's entries.
     full: Option<FullLevel>,
+    /// What `--thesis` changes, the same way (the full level where absent).
+    thesis_resolution: Option<FullLevel>,
     /// What `--solver implicit` merges into the deck (elastic cases).
     implicit: Option<toml::Table>,
 }
@@ -153,18 +155,25 @@ pub fn load_with(
         .and_then(|s| s.to_str())
         .unwrap_or_default();
     let (mut tolerance, mut quantity, mut changed) = (v.tolerance_percent, v.quantity, false);
-    let (band, band_table) = match level {
-        Level::Quick => (v.regression, "[validation]"),
-        Level::Full => (
-            v.full.as_ref().and_then(|f| f.regression),
-            "[validation.full]",
-        ),
+    let finer = match level {
+        Level::Quick => None,
+        Level::Full => v.full.as_ref().map(|f| (f, "[validation.full]")),
+        Level::Thesis => (v
+            .thesis_resolution
+            .as_ref()
+            .map(|f| (f, "[validation.thesis_resolution]")))
+        .or(v.full.as_ref().map(|f| (f, "[validation.full]"))),
     };
-    if let (Level::Full, Some(full)) = (level, &v.full) {
-        merge(&mut deck, &full.deck, "")
-            .map_err(|e| format!("{}: [validation.full]: {e}", path.display()))?;
-        tolerance = full.tolerance_percent.unwrap_or(tolerance);
-        quantity = full.quantity.clone().unwrap_or(quantity);
+    let (band, band_table) = match finer {
+        None if level == Level::Quick => (v.regression, "[validation]"),
+        None => (None, ""),
+        Some((f, table)) => (f.regression, table),
+    };
+    if let Some((finer, table)) = finer {
+        merge(&mut deck, &finer.deck, "")
+            .map_err(|e| format!("{}: {table}: {e}", path.display()))?;
+        tolerance = finer.tolerance_percent.unwrap_or(tolerance);
+        quantity = finer.quantity.clone().unwrap_or(quantity);
         changed = true;
     }
     if let Some(b) = band {

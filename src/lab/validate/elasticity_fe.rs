@@ -157,13 +157,17 @@ impl Problem {
             return Err(format!("element order {} (use 1 to 6)", self.order));
         }
         for (axis, p) in self.planes.iter().enumerate() {
-            if p.len() < 2 || p.windows(2).any(|w| !(w[1] > w[0])) {
+            if p.len() < 2
+                || p.windows(2)
+                    .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+            {
                 return Err(format!(
                     "the element planes along axis {axis} must increase: {p:?}"
                 ));
             }
         }
-        if !(self.youngs > 0.0) || !(self.poisson > -1.0 && self.poisson < 0.5) {
+        let moduli_ok = self.youngs > 0.0 && self.poisson > -1.0 && self.poisson < 0.5;
+        if !moduli_ok {
             return Err(format!(
                 "E = {} and ν = {}: need E > 0, −1 < ν < ½",
                 self.youngs, self.poisson

@@ -202,11 +202,8 @@ fn problem_of(case: &Case, scene: &Scene, order: usize, across: usize) -> Result
 
 fn report(rows: &[FeRow], opts: &FeCheckOptions) -> String {
     let mut s = format!(
-        "# Beam formulas against 3D elasticity (`pdq validate --fe-check`, {} level, {} elements across the depth)\n\n",
-        match opts.level {
-            Level::Quick => "quick",
-            Level::Full => "full",
-        },
+        "# Beam formulas against 3D elasticity (`pdq validate --fe-check {}`, {} elements across the depth)\n\n",
+        opts.level.flag(),
         opts.elements_across
     );
     s.push_str("| case | order | unknowns | elasticity deflection | change from the order before | formula | elasticity / formula | run time s |\n|---|---|---|---|---|---|---|---|\n");
