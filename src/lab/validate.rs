@@ -225,43 +225,7 @@ pub fn run_case_long(
     let error_percent = 100.0 * (measured - case.reference) / case.reference;
     let passed = measured.is_finite() && error_percent.abs() <= case.tolerance_percent;
     let converged = summary.solve_converged();
-    let plot = match &case.plot {
-        Some(pl) => {
-            let measured_curve = (pl.measured)(dir)?;
-            let reference = match &pl.reference {
-                Curve::Points(p) => p.clone(),
-                // A level over the measured range.
-                Curve::Level(y) => {
-                    let reach = measured_curve.iter().map(|p| p.0).fold(0.0, f64::max);
-                    vec![(0.0, *y), (reach, *y)]
-                }
-            };
-            let path = dir.with_extension("png");
-            crate::output::plot::xy(
-                &path,
-                &format!(
-                    "{}: PDQ {:.4e}, reference {:.4e} ({:+.2} %)",
-                    case.name, measured, case.reference, error_percent
-                ),
-                &pl.x_label,
-                &pl.y_label,
-                &[
-                    crate::output::plot::Series {
-                        name: "PDQ",
-                        points: &measured_curve,
-                        mark: crate::output::plot::Mark::Points,
-                    },
-                    crate::output::plot::Series {
-                        name: "reference",
-                        points: &reference,
-                        mark: crate::output::plot::Mark::Line,
-                    },
-                ],
-            )?;
-            Some(path)
-        }
-        None => None,
-    };
+    let plot = draw_plot(case, dir, measured, error_percent)?;
     // A picture that cannot be drawn is reported, not allowed to lose the measured value.
     let views = if case.damage_views {
         let path = dir.with_file_name(format!("{}_damage.png", case.name));
@@ -298,6 +262,52 @@ pub fn run_case_long(
         band: case.band,
         plot,
         views,
+    })
+}
+
+/// The case's plot, measured curve against the reference (`None`: the case draws none).
+fn draw_plot(
+    case: &Case,
+    dir: &Path,
+    measured: f64,
+    error_percent: f64,
+) -> Result<Option<PathBuf>, String> {
+    Ok(match &case.plot {
+        Some(pl) => {
+            let measured_curve = (pl.measured)(dir)?;
+            let reference = match &pl.reference {
+                Curve::Points(p) => p.clone(),
+                // A level over the measured range.
+                Curve::Level(y) => {
+                    let reach = measured_curve.iter().map(|p| p.0).fold(0.0, f64::max);
+                    vec![(0.0, *y), (reach, *y)]
+                }
+            };
+            let path = dir.with_extension("png");
+            crate::output::plot::xy(
+                &path,
+                &format!(
+                    "{}: PDQ {:.4e}, reference {:.4e} ({:+.2} %)",
+                    case.name, measured, case.reference, error_percent
+                ),
+                &pl.x_label,
+                &pl.y_label,
+                &[
+                    crate::output::plot::Series {
+                        name: "PDQ",
+                        points: &measured_curve,
+                        mark: crate::output::plot::Mark::Points,
+                    },
+                    crate::output::plot::Series {
+                        name: "reference",
+                        points: &reference,
+                        mark: crate::output::plot::Mark::Line,
+                    },
+                ],
+            )?;
+            Some(path)
+        }
+        None => None,
     })
 }
 
