@@ -253,6 +253,7 @@ fn own_law(m: &Material, delta: f64) -> Result<Law, ModelError> {
             "youngs_modulus",
             "poisson_ratio",
             "tensile_stretch",
+            "fracture_energy",
             "compressive_stretch",
         ],
     };
@@ -262,7 +263,7 @@ fn own_law(m: &Material, delta: f64) -> Result<Law, ModelError> {
     let c = thesis_micromodulus(e, nu, delta);
     Ok(match m.kind {
         MaterialKind::Concrete => {
-            let tensile = m.required("tensile_stretch", Dimension::NUMBER, name)?;
+            let tensile = tensile_stretch(m, c, delta)?;
             let compressive = m.checked(
                 "compressive_stretch",
                 Dimension::NUMBER,
@@ -299,6 +300,29 @@ fn own_law(m: &Material, delta: f64) -> Result<Law, ModelError> {
             )))
         }
     })
+}
+
+/// A concrete's tensile critical stretch: `tensile_stretch` as given (the thesis's fixed
+/// stretch, f_t/E), or from `fracture_energy` G_F and the horizon, s_t = √(10 G_F/(π c δ⁵)):
+/// the energy that breaking every bond across a unit area takes (the PMB relation, with the
+/// thesis's micromodulus c). A fixed stretch dissipates G = π c δ⁵ s_t²/10, which grows with δ,
+/// so its fracture-controlled strengths fall as the lattice is refined; a fixed G_F keeps that
+/// energy, and the stretch falls as 1/√δ instead (validation/README.md, the lap splices).
+fn tensile_stretch(m: &Material, c: f64, delta: f64) -> Result<f64, ModelError> {
+    let stretch = m.positive("tensile_stretch", Dimension::NUMBER)?;
+    let energy = m.positive("fracture_energy", Dimension::ENERGY_PER_AREA)?;
+    match (stretch, energy) {
+        (Some(s), None) => Ok(s),
+        (None, Some(g)) => Ok((10.0 * g / (PI * c * delta.powi(5))).sqrt()),
+        (None, None) => Err(m.error(format!(
+            "material '{}' (model 'concrete') needs 'tensile_stretch' or 'fracture_energy'",
+            m.name
+        ))),
+        (Some(_), Some(_)) => Err(m.error(format!(
+            "material '{}': give 'tensile_stretch' or 'fracture_energy', not both",
+            m.name
+        ))),
+    }
 }
 
 /// The law between two materials' own laws.

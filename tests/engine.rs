@@ -389,6 +389,59 @@ compressive_stretch = -1.1e-3
 }
 
 #[test]
+fn concrete_fracture_energy_sets_the_tensile_stretch_from_the_horizon() {
+    // At ν = ¼ the thesis's micromodulus makes G_F = π c δ⁵ s_t²/10 = 1.2 E δ s_t²: the
+    // fracture energy of the thesis's stretch at its 3 in horizon must break the bond where
+    // that stretch does, and the same energy at twice the horizon at a stretch 1/√2 as large.
+    let (e, s_t) = (3.605e6, 1.387e-4);
+    let text = |horizon: f64, failure: &str| {
+        format!(
+            r#"units = "in-lbf-s"
+[model]
+name = "concrete"
+horizon = "{horizon} in"
+[lattice]
+spacing = "1 in"
+[materials.concrete]
+kind = "concrete"
+density = "145 lb/ft^3"
+youngs_modulus = "3605 ksi"
+poisson_ratio = 0.25
+{failure}
+compressive_stretch = -1.1e-3
+"#
+        )
+    };
+    let g_f = 1.2 * e * 3.0 * s_t * s_t;
+    for (horizon, at) in [(3.0, s_t), (6.0, s_t / 2f64.sqrt())] {
+        for (s, broken) in [(0.97 * at, false), (1.03 * at, true)] {
+            let failure = format!("fracture_energy = \"{g_f:e} lbf/in\"");
+            let deck_text = two_particles(&text(horizon, &failure), "concrete", 1.0);
+            let scene = deck::parse(&deck_text, "t.toml", "t").unwrap();
+            let mut st = build_as::<Concrete>(&scene).unwrap();
+            let right = (0..2).find(|&i| st.sim.particles.x0[i][0] > 1.0).unwrap();
+            st.sim.particles.alter[right].pos[0] = st.sim.particles.x0[right][0] + 2.0 * s;
+            st.sim.compute_forces();
+            assert_eq!(st.sim.bonds.broken[0], broken, "δ {horizon}, stretch {s}");
+        }
+    }
+    for (failure, says) in [
+        (
+            format!("tensile_stretch = {s_t:e}\nfracture_energy = \"1 lbf/in\""),
+            "not both",
+        ),
+        (String::new(), "needs 'tensile_stretch' or 'fracture_energy'"),
+    ] {
+        let deck_text = two_particles(&text(3.0, &failure), "concrete", 1.0);
+        let err = deck::parse(&deck_text, "t.toml", "t")
+            .map_err(|e| e.to_string())
+            .and_then(|scene| build_as::<Concrete>(&scene).map(|_| ()).map_err(|e| e.to_string()))
+            .unwrap_err();
+        assert!(err.contains(says), "{err}");
+    }
+}
+
+#[test]
 fn two_identical_materials_give_the_single_material_result() {
     // The bond loop has a fast path for scenes of one material; a scene of two materials with
     // the same properties takes the general path and must give bit-identical results.
