@@ -430,12 +430,19 @@ compressive_stretch = -1.1e-3
             format!("tensile_stretch = {s_t:e}\nfracture_energy = \"1 lbf/in\""),
             "not both",
         ),
-        (String::new(), "needs 'tensile_stretch' or 'fracture_energy'"),
+        (
+            String::new(),
+            "needs 'tensile_stretch' or 'fracture_energy'",
+        ),
     ] {
         let deck_text = two_particles(&text(3.0, &failure), "concrete", 1.0);
         let err = deck::parse(&deck_text, "t.toml", "t")
             .map_err(|e| e.to_string())
-            .and_then(|scene| build_as::<Concrete>(&scene).map(|_| ()).map_err(|e| e.to_string()))
+            .and_then(|scene| {
+                build_as::<Concrete>(&scene)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            })
             .unwrap_err();
         assert!(err.contains(says), "{err}");
     }
