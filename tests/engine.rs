@@ -344,14 +344,14 @@ yield_stretch = 0.01
     assert!(!st.sim.bonds.broken[0]);
 }
 
-#[test]
-fn concrete_bond_breaks_in_tension_and_compression() {
-    let text = |s_t: f64| {
-        format!(
-            r#"units = "in-lbf-s"
+/// The head of a two-particle deck of the thesis's concrete at `horizon` (in), its tensile
+/// failure given by the line `failure`.
+fn thesis_concrete(horizon: f64, failure: &str) -> String {
+    format!(
+        r#"units = "in-lbf-s"
 [model]
 name = "concrete"
-horizon = "3 in"
+horizon = "{horizon} in"
 [lattice]
 spacing = "1 in"
 [materials.concrete]
@@ -359,11 +359,15 @@ kind = "concrete"
 density = "145 lb/ft^3"
 youngs_modulus = "3605 ksi"
 poisson_ratio = 0.25
-tensile_stretch = {s_t:e}
+{failure}
 compressive_stretch = -1.1e-3
 "#
-        )
-    };
+    )
+}
+
+#[test]
+fn concrete_bond_breaks_in_tension_and_compression() {
+    let text = |s_t: f64| thesis_concrete(3.0, &format!("tensile_stretch = {s_t:e}"));
     for (s, broken) in [
         (1.0e-4, false),
         (1.5e-4, true),
@@ -394,24 +398,7 @@ fn concrete_fracture_energy_sets_the_tensile_stretch_from_the_horizon() {
     // fracture energy of the thesis's stretch at its 3 in horizon must break the bond where
     // that stretch does, and the same energy at twice the horizon at a stretch 1/√2 as large.
     let (e, s_t) = (3.605e6, 1.387e-4);
-    let text = |horizon: f64, failure: &str| {
-        format!(
-            r#"units = "in-lbf-s"
-[model]
-name = "concrete"
-horizon = "{horizon} in"
-[lattice]
-spacing = "1 in"
-[materials.concrete]
-kind = "concrete"
-density = "145 lb/ft^3"
-youngs_modulus = "3605 ksi"
-poisson_ratio = 0.25
-{failure}
-compressive_stretch = -1.1e-3
-"#
-        )
-    };
+    let text = thesis_concrete;
     let g_f = 1.2 * e * 3.0 * s_t * s_t;
     for (horizon, at) in [(3.0, s_t), (6.0, s_t / 2f64.sqrt())] {
         for (s, broken) in [(0.97 * at, false), (1.03 * at, true)] {
