@@ -184,6 +184,10 @@ struct ValidateArgs {
     /// Sweep: solvers, comma-separated (implicit, newton_krylov, adr).
     #[arg(long, value_delimiter = ',', default_value = "implicit")]
     solvers: Vec<String>,
+    /// Sweep: the relative residual each solve stops at (default: the case file's, 1e-9
+    /// for the implicit and matrix-free solves; ask 1e-8 from about 25 planes on).
+    #[arg(long)]
+    tolerance: Option<f64>,
     /// Checkpoint each case every T minutes of wall time (long --full runs).
     #[arg(long, value_name = "T")]
     checkpoint_minutes: Option<f64>,
@@ -388,15 +392,15 @@ fn run_deck(a: RunArgs) -> Result<bool, String> {
 fn validate(a: ValidateArgs) -> Result<(), String> {
     let threads = a.threads.unwrap_or_else(cores);
     if a.sweep {
-        let s = pdq::lab::validate::sweep(
-            &a.output,
-            &a.case_dir,
-            &a.models,
-            &a.planes,
-            &a.m,
-            &a.solvers,
-            a.threads.unwrap_or(1),
-        )?;
+        let plan = pdq::lab::validate::SweepPlan {
+            models: &a.models,
+            planes: &a.planes,
+            ms: &a.m,
+            solvers: &a.solvers,
+            threads: a.threads.unwrap_or(1),
+            tolerance: a.tolerance,
+        };
+        let s = pdq::lab::validate::sweep(&a.output, &a.case_dir, &plan)?;
         print!("{s}");
         return Ok(());
     }

@@ -150,16 +150,16 @@ history_every = 1
 #[test]
 fn the_sweep_reports_error_against_run_time() {
     let dir = out("sweep");
-    let table = validate::sweep(
-        &dir,
-        Path::new("validation"),
-        &["pmb".to_string()],
-        &[3, 5],
-        &[3.0],
-        &["implicit".to_string()],
-        1,
-    )
-    .unwrap();
+    let (models, solvers) = (["pmb".to_string()], ["implicit".to_string()]);
+    let plan = |planes, tolerance| validate::SweepPlan {
+        models: &models,
+        planes,
+        ms: &[3.0],
+        solvers: &solvers,
+        threads: 1,
+        tolerance,
+    };
+    let table = validate::sweep(&dir, Path::new("validation"), &plan(&[3, 5], None)).unwrap();
     let rows: Vec<&str> = table.lines().filter(|l| l.starts_with("| pmb")).collect();
     assert_eq!(rows.len(), 2, "{table}");
     let column =
@@ -182,17 +182,10 @@ fn the_sweep_reports_error_against_run_time() {
         assert!(row.contains("| yes |"), "{row}");
     }
     assert!(dir.join("sweep.png").exists() && dir.join("sweep.md").exists());
-    let e = validate::sweep(
-        &dir,
-        Path::new("validation"),
-        &["pmb".to_string()],
-        &[4],
-        &[3.0],
-        &["implicit".to_string()],
-        1,
-    )
-    .unwrap_err();
+    let e = validate::sweep(&dir, Path::new("validation"), &plan(&[4], None)).unwrap_err();
     assert!(e.contains("odd"), "{e}");
+    let e = validate::sweep(&dir, Path::new("validation"), &plan(&[5], Some(0.0))).unwrap_err();
+    assert!(e.contains("--tolerance"), "{e}");
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -26,7 +26,7 @@ mod sweep;
 
 pub use case_file::ElasticSolver;
 pub use measures::{last_of, read_history};
-pub use sweep::{compare_adr, sweep, SweepPoint};
+pub use sweep::{compare_adr, sweep, SweepPlan, SweepPoint};
 
 /// The resolution of a validation run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -17,8 +17,13 @@ const SPACING: &str = "0.01 m";
 
 /// The cantilever of `validation/cantilever_MODEL.toml` with `cells` lattice planes across its
 /// square section and horizon ratio `m`: span 10 sections, clamped over three planes, the
-/// load on the last two, the probes under the load's centroid (as in the file).
-fn resize(cells: usize, m: f64) -> impl Fn(&mut toml::Table) -> Result<(), String> {
+/// load on the last two, the probes under the load's centroid (as in the file); its solve
+/// stops at relative residual `tolerance` where one is given.
+fn resize(
+    cells: usize,
+    m: f64,
+    tolerance: Option<f64>,
+) -> impl Fn(&mut toml::Table) -> Result<(), String> {
     move |deck| {
         let dx = 0.01;
         if deck.get("lattice").and_then(|l| l.get("spacing")) != Some(&Value::from(SPACING)) {
@@ -45,6 +50,12 @@ fn resize(cells: usize, m: f64) -> impl Fn(&mut toml::Table) -> Result<(), Strin
         model
             .ok_or("the cantilever has no [model]")?
             .insert("m".into(), Value::from(m));
+        if let Some(t) = tolerance {
+            let solver = deck.get_mut("solver").and_then(Value::as_table_mut);
+            solver
+                .ok_or("the cantilever has no [solver]")?
+                .insert("tolerance".into(), Value::from(t));
+        }
         Ok(())
     }
 }
@@ -83,37 +94,53 @@ pub struct SweepPoint {
     pub force_evaluations: u64,
 }
 
+/// What `pdq validate --sweep` runs: every model × section resolution × horizon ratio ×
+/// solver.
+pub struct SweepPlan<'a> {
+    pub models: &'a [String],
+    /// Lattice planes across the square section, odd (a particle on the axis).
+    pub planes: &'a [usize],
+    pub ms: &'a [f64],
+    /// "implicit", "newton_krylov", "adr".
+    pub solvers: &'a [String],
+    /// procCubes of each run.
+    pub threads: usize,
+    /// The relative residual each solve stops at, in place of the case file's. The 10⁻⁹ of
+    /// the files is below what a matrix-free solve of 158,750 particles reaches (its force
+    /// differences stall near 2·10⁻⁹); a fine sweep asks 10⁻⁸, which moves a deflection by
+    /// far less than its last printed digit.
+    pub tolerance: Option<f64>,
+}
+
 /// `pdq validate --sweep`: the elastic cantilever of each model (`cases/cantilever_MODEL.toml`)
-/// at each section resolution (lattice planes across the section, odd) and horizon ratio m,
-/// solved by each solver ("implicit", "newton_krylov", "adr"); the error against Timoshenko
-/// with the deck's isotropic moduli and with the lattice's own along the beam's axis
-/// (`lattice.rs`), the run time of each, a table and a PNG plot of error against run time.
-/// Runs one at a time, each on `threads` procCubes.
-pub fn sweep(
-    output: &Path,
-    cases: &Path,
-    models: &[String],
-    cells: &[usize],
-    ms: &[f64],
-    solvers: &[String],
-    threads: usize,
-) -> Result<String, String> {
+/// at each section resolution and horizon ratio m, solved by each solver; the error against
+/// Timoshenko with the deck's isotropic moduli and with the lattice's own along the beam's
+/// axis (`lattice.rs`), the run time of each, a table and a PNG plot of error against run
+/// time. Runs one at a time.
+pub fn sweep(output: &Path, cases: &Path, plan: &SweepPlan) -> Result<String, String> {
+    if let Some(t) = plan.tolerance {
+        if !(t.is_finite() && t > 0.0 && t < 1.0) {
+            return Err(format!(
+                "--tolerance {t}: give a relative residual between 0 and 1"
+            ));
+        }
+    }
     std::fs::create_dir_all(output).map_err(|e| format!("{}: {e}", output.display()))?;
     let mut points = Vec::new();
-    for model in models {
-        for &c in cells {
+    for model in plan.models {
+        for &c in plan.planes {
             if c % 2 == 0 || c < 3 {
                 return Err(format!(
                     "--cells {c}: give odd numbers ≥ 3 (a particle on the axis)"
                 ));
             }
-            for &m in ms {
-                for solver in solvers {
+            for &m in plan.ms {
+                for solver in plan.solvers {
                     let how = case_file::ElasticSolver::named(solver)
                         .map_err(|e| format!("--solvers: {e}"))?;
                     let solver = how.name();
                     let file = cases.join(format!("cantilever_{model}.toml"));
-                    let edit = resize(c, m);
+                    let edit = resize(c, m, plan.tolerance);
                     let mut case =
                         case_file::load_with(&file, Level::Quick, how, Some(&edit as Edit))?;
                     if !(m == 3.0 && [7, 13].contains(&c)) {
@@ -123,7 +150,7 @@ pub fn sweep(
                     let dir = output.join(format!("{}_{solver}", case.name));
                     eprintln!("sweep      {} by {solver} ...", case.name);
                     let lattice = lattice_reference(&case)?;
-                    let o = run_case(&case, &dir, threads)?;
+                    let o = run_case(&case, &dir, plan.threads)?;
                     let lattice_error = 100.0 * (o.measured - lattice.value) / lattice.value;
                     eprintln!(
                         "           {:+.2} % (lattice moduli {lattice_error:+.2} %) in {:.1} s ({} particles)",
