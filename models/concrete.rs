@@ -309,20 +309,14 @@ fn own_law(m: &Material, delta: f64) -> Result<Law, ModelError> {
 /// so its fracture-controlled strengths fall as the lattice is refined; a fixed G_F keeps that
 /// energy, and the stretch falls as 1/√δ instead (validation/README.md, the lap splices).
 fn tensile_stretch(m: &Material, c: f64, delta: f64) -> Result<f64, ModelError> {
-    let stretch = m.positive("tensile_stretch", Dimension::NUMBER)?;
-    let energy = m.positive("fracture_energy", Dimension::ENERGY_PER_AREA)?;
-    match (stretch, energy) {
-        (Some(s), None) => Ok(s),
-        (None, Some(g)) => Ok((10.0 * g / (PI * c * delta.powi(5))).sqrt()),
-        (None, None) => Err(m.error(format!(
-            "material '{}' (model 'concrete') needs 'tensile_stretch' or 'fracture_energy'",
-            m.name
-        ))),
-        (Some(_), Some(_)) => Err(m.error(format!(
-            "material '{}': give 'tensile_stretch' or 'fracture_energy', not both",
-            m.name
-        ))),
-    }
+    let from_energy = |g: f64| (10.0 * g / (PI * c * delta.powi(5))).sqrt();
+    m.stretch_or_energy("tensile_stretch", from_energy)?
+        .ok_or_else(|| {
+            m.error(format!(
+                "material '{}' (model 'concrete') needs 'tensile_stretch' or 'fracture_energy'",
+                m.name
+            ))
+        })
 }
 
 /// The law between two materials' own laws.

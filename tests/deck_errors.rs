@@ -372,6 +372,24 @@ fn pmb_with_poisson_ratio() {
     );
 }
 
+/// A PMB material that gives both its critical stretch and a fracture energy to derive it from.
+#[test]
+fn pmb_with_stretch_and_fracture_energy() {
+    let deck = edit(
+        "critical_stretch = 0.0005\n",
+        "critical_stretch = 0.0005\nfracture_energy = \"10 J/m^2\"\n",
+    );
+    assert_rejected(
+        "pmb_stretch_and_energy",
+        &deck,
+        &[
+            "mortar",
+            "'critical_stretch' or 'fracture_energy', not both",
+        ],
+        None,
+    );
+}
+
 /// As above, but the error should point at the material (or its poisson_ratio), not at `[model]`.
 #[test]
 fn pmb_with_poisson_ratio_line() {

@@ -313,16 +313,26 @@ impl Material {
         &self,
         from_energy: impl FnOnce(f64) -> f64,
     ) -> Result<f64, ModelError> {
-        let s = self.positive("critical_stretch", Dimension::NUMBER)?;
+        Ok(self
+            .stretch_or_energy("critical_stretch", from_energy)?
+            .unwrap_or(f64::INFINITY))
+    }
+
+    /// The stretch under `key`, or the one `from_energy` gives for `fracture_energy`: a law
+    /// breaks at one or the other. `None` where neither is given; both are an error.
+    pub fn stretch_or_energy(
+        &self,
+        key: &str,
+        from_energy: impl FnOnce(f64) -> f64,
+    ) -> Result<Option<f64>, ModelError> {
+        let s = self.positive(key, Dimension::NUMBER)?;
         let g0 = self.positive("fracture_energy", Dimension::ENERGY_PER_AREA)?;
         match (s, g0) {
-            (Some(s), None) => Ok(s),
-            (None, Some(g0)) => Ok(from_energy(g0)),
-            (None, None) => Ok(f64::INFINITY),
             (Some(_), Some(_)) => Err(self.error(format!(
-                "material '{}': give 'critical_stretch' or 'fracture_energy', not both",
+                "material '{}': give '{key}' or 'fracture_energy', not both",
                 self.name
             ))),
+            (s, g0) => Ok(s.or_else(|| g0.map(from_energy))),
         }
     }
 }
