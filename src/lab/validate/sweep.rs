@@ -125,15 +125,15 @@ pub fn sweep(output: &Path, cases: &Path, plan: &SweepPlan) -> Result<String, St
             ));
         }
     }
+    if let Some(c) = plan.planes.iter().find(|&&c| c % 2 == 0 || c < 3) {
+        return Err(format!(
+            "--planes {c}: give odd numbers ≥ 3 (a particle on the axis)"
+        ));
+    }
     std::fs::create_dir_all(output).map_err(|e| format!("{}: {e}", output.display()))?;
     let mut points = Vec::new();
     for model in plan.models {
         for &c in plan.planes {
-            if c % 2 == 0 || c < 3 {
-                return Err(format!(
-                    "--cells {c}: give odd numbers ≥ 3 (a particle on the axis)"
-                ));
-            }
             for &m in plan.ms {
                 for solver in plan.solvers {
                     let how = case_file::ElasticSolver::named(solver)
