@@ -4,6 +4,7 @@
 //! owner; the model returns the generalized force on both ends and the loop adds them, so
 //! equal-and-opposite forces and unequal micropolar moments go through the same code.
 
+use crate::engine::bond_geoms::GeomSlice;
 use crate::engine::bonds::BondList;
 use crate::engine::particles::Particles;
 use crate::model::attributes::{add_assign, Attributes};
@@ -331,13 +332,27 @@ where
         state,
     } = ends;
     let (offsets, partner, geom, broken, history) = bonds.parts_mut();
+    // SAFETY: every partner index is below the particle count (BondList keeps the partner
+    // list private and its maximum; checked above), and all per-particle arrays have that
+    // length. Unchecked access lets the compiler drop the loads of fields the model never
+    // reads, which bounds checks would keep alive.
+    let side = |j: usize| unsafe {
+        Side::<M> {
+            x0: x0.get_unchecked(j),
+            volume: *volume.get_unchecked(j),
+            material: *material.get_unchecked(j),
+            alter: alter.get_unchecked(j),
+            fixed: fixed.get_unchecked(j),
+            state: state.get_unchecked(j),
+        }
+    };
     let mut newly_broken = 0;
     for i in 0..n_owned {
         // Local copies: the compiler cannot tell that the stores into `out` below leave
         // particle i's records alone, so references into the arrays would be reloaded on
         // every bond.
         let (x0_i, alter_i, fixed_i, state_i) = (x0[i], alter[i], fixed[i], state.copy(i));
-        let side_i = Side::<M> {
+        let owner = Side::<M> {
             x0: &x0_i,
             volume: volume[i],
             material: material[i],
@@ -345,34 +360,63 @@ where
             fixed: &fixed_i,
             state: &state_i,
         };
+        let range = offsets[i] as usize..offsets[i + 1] as usize;
+        let family = Family {
+            partner: &partner[range.clone()],
+            geom: geom.slice(range.clone()),
+            broken: &mut broken[range.clone()],
+            history: &mut history[range],
+        };
+        // SAFETY: the partners are in bounds of `out` and of `side`, as above.
+        let (oi, broke) =
+            unsafe { family.sweep::<T, L, V, _, DAMAGE>(&owner, &side, &laws, &visit, out) };
+        newly_broken += broke;
+        add_assign(&mut out[i], &oi);
+    }
+    newly_broken
+}
+
+/// One owner's bonds, as the sweep visits them.
+struct Family<'a, M: Model> {
+    partner: &'a [u32],
+    geom: GeomSlice<'a>,
+    broken: &'a mut [bool],
+    history: &'a mut [M::Bond],
+}
+
+impl<M: Model> Family<'_, M> {
+    /// Visits the family's intact bonds in bond order, adding each partner's contribution into
+    /// `out`; returns the owner's sum and how many bonds broke. Four bonds go at once if the
+    /// model asks (`Model::BOND_LANES`) and the next four are intact, as one lane group;
+    /// otherwise, or if the model refuses the group (one of its bonds breaks now), they go
+    /// one by one. The sums are made in bond order either way.
+    ///
+    /// # Safety
+    /// Every partner is below `out.len()` and is a particle `side` may read.
+    #[inline(always)]
+    unsafe fn sweep<'s, T, L, V, S, const DAMAGE: bool>(
+        mut self,
+        owner: &Side<'_, M>,
+        side: &S,
+        laws: &L,
+        visit: &V,
+        out: &mut [T],
+    ) -> (T, usize)
+    where
+        T: Attributes,
+        L: Laws<M>,
+        V: BondVisit<M, T>,
+        S: Fn(usize) -> Side<'s, M>,
+        M: 's,
+    {
         // The owner's sum: in `oi`, or in `lane_sum` while lane groups run.
         let mut oi = T::default();
         let mut lane_sum = OwnerSum::from(&oi);
         let mut in_lanes = M::BOND_LANES == LANES;
-        let range = offsets[i] as usize..offsets[i + 1] as usize;
-        let (partner, geom) = (&partner[range.clone()], geom.slice(range.clone()));
-        let (broken, history) = (&mut broken[range.clone()], &mut history[range]);
-        // SAFETY: every partner index is below the particle count (BondList keeps the
-        // partner list private and its maximum; checked above), and all per-particle arrays
-        // have that length. Unchecked access lets the compiler drop the loads of fields the
-        // model never reads, which bounds checks would keep alive.
-        let side = |j: usize| unsafe {
-            Side::<M> {
-                x0: x0.get_unchecked(j),
-                volume: *volume.get_unchecked(j),
-                material: *material.get_unchecked(j),
-                alter: alter.get_unchecked(j),
-                fixed: fixed.get_unchecked(j),
-                state: state.get_unchecked(j),
-            }
-        };
-        let len = partner.len();
+        let mut newly_broken = 0;
+        let len = self.partner.len();
         let mut k = 0;
         while k < len {
-            // Four bonds at once if the model asks (`Model::BOND_LANES`) and the next four
-            // are intact, as one lane group; otherwise, or if the model refuses the group (one
-            // of its bonds breaks now), they go one by one. The sums are made in bond order
-            // either way.
             let mut end = k + 1;
             if M::BOND_LANES == LANES && k + LANES <= len {
                 if !in_lanes {
@@ -380,13 +424,13 @@ where
                     in_lanes = true;
                 }
                 let group = Group {
-                    owner: &side_i,
-                    js: std::array::from_fn(|l| partner[k + l] as usize),
-                    geoms: std::array::from_fn(|l| geom.get(k + l)),
+                    owner,
+                    js: std::array::from_fn(|l| self.partner[k + l] as usize),
+                    geoms: std::array::from_fn(|l| self.geom.get(k + l)),
                 };
-                let intact = !DAMAGE || !broken[k..k + LANES].iter().any(|&b| b);
-                // SAFETY: partners are in bounds, as above.
-                if intact && unsafe { group.run(&visit, &laws, &side, &mut lane_sum, out) } {
+                let intact = !DAMAGE || !self.broken[k..k + LANES].iter().any(|&b| b);
+                // SAFETY: the caller keeps the partners in bounds.
+                if intact && unsafe { group.run(visit, laws, side, &mut lane_sum, out) } {
                     k += LANES;
                     continue;
                 }
@@ -396,34 +440,61 @@ where
                 lane_sum.store(&mut oi);
                 in_lanes = false;
             }
-            while k < end {
-                if !(DAMAGE && broken[k]) {
-                    let j = partner[k] as usize;
-                    let sj = side(j);
-                    let r = visit.visit(
-                        &laws.of(side_i.material, sj.material),
-                        &side_i,
-                        &sj,
-                        geom.get(k),
-                        &mut history[k],
-                    );
-                    // SAFETY: partners are in bounds, as above.
-                    newly_broken += add_or_break::<T, DAMAGE>(
-                        r,
-                        &mut oi,
-                        unsafe { out.get_unchecked_mut(j) },
-                        &mut broken[k],
-                    );
-                }
-                k += 1;
-            }
+            // SAFETY: the caller keeps the partners in bounds.
+            newly_broken += unsafe {
+                self.one_by_one::<T, L, V, S, DAMAGE>(k..end, owner, side, laws, visit, &mut oi, out)
+            };
+            k = end;
         }
         if in_lanes {
             lane_sum.store(&mut oi);
         }
-        add_assign(&mut out[i], &oi);
+        (oi, newly_broken)
     }
-    newly_broken
+
+    /// Visits the intact bonds of `bonds` one at a time, adding into the owner's sum `oi` and
+    /// the partners' records in `out`, or breaking them; returns how many broke.
+    ///
+    /// # Safety
+    /// As [`Family::sweep`].
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn one_by_one<'s, T, L, V, S, const DAMAGE: bool>(
+        &mut self,
+        bonds: std::ops::Range<usize>,
+        owner: &Side<'_, M>,
+        side: &S,
+        laws: &L,
+        visit: &V,
+        oi: &mut T,
+        out: &mut [T],
+    ) -> usize
+    where
+        T: Attributes,
+        L: Laws<M>,
+        V: BondVisit<M, T>,
+        S: Fn(usize) -> Side<'s, M>,
+        M: 's,
+    {
+        let mut newly_broken = 0;
+        for k in bonds {
+            if DAMAGE && self.broken[k] {
+                continue;
+            }
+            let j = self.partner[k] as usize;
+            let sj = side(j);
+            let law = laws.of(owner.material, sj.material);
+            let r = visit.visit(&law, owner, &sj, self.geom.get(k), &mut self.history[k]);
+            // SAFETY: the caller keeps the partners in bounds.
+            newly_broken += add_or_break::<T, DAMAGE>(
+                r,
+                oi,
+                unsafe { out.get_unchecked_mut(j) },
+                &mut self.broken[k],
+            );
+        }
+        newly_broken
+    }
 }
 
 /// [`check_store`] for one sweep's per-particle arrays, its output and its bond list.
