@@ -442,7 +442,15 @@ impl<M: Model> Family<'_, M> {
             }
             // SAFETY: the caller keeps the partners in bounds.
             newly_broken += unsafe {
-                self.one_by_one::<T, L, V, S, DAMAGE>(k..end, owner, side, laws, visit, &mut oi, out)
+                self.one_by_one::<T, L, V, S, DAMAGE>(
+                    k..end,
+                    owner,
+                    side,
+                    laws,
+                    visit,
+                    &mut oi,
+                    out,
+                )
             };
             k = end;
         }
