@@ -5,6 +5,7 @@
 
 pub mod analysis;
 pub mod bond_geoms;
+pub mod bond_sums;
 pub mod bonds;
 pub mod boundary;
 pub mod cells;

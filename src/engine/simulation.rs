@@ -279,7 +279,7 @@ impl<M: Model> Simulation<M> {
     }
 
     pub fn strain_energy(&self) -> f64 {
-        forces::strain_energy(&self.model, &self.particles, &self.bonds)
+        crate::engine::bond_sums::strain_energy(&self.model, &self.particles, &self.bonds)
     }
 
     pub fn kinetic_energy(&self) -> f64 {

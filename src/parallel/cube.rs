@@ -248,7 +248,7 @@ impl<M: Model> Cube<M> {
         if M::FIXED_FROM_BONDS {
             let sim = &mut self.sim;
             let mut sums =
-                crate::engine::forces::bond_fixed_sums(&sim.model, &sim.particles, &sim.bonds);
+                crate::engine::bond_sums::bond_fixed_sums(&sim.model, &sim.particles, &sim.bonds);
             self.wall
                 .reverse(&mut sums, crate::model::attributes::add_assign);
             let p = &mut self.sim.particles;

@@ -314,7 +314,7 @@ fn whole_fixed<M: Model>(
     use crate::model::attributes::add_assign;
     let base = q.fixed.clone();
     if M::FIXED_FROM_BONDS {
-        let mut sums = crate::engine::forces::bond_fixed_sums(model, q, bonds);
+        let mut sums = crate::engine::bond_sums::bond_fixed_sums(model, q, bonds);
         wall.reverse(&mut sums, add_assign);
         for (f, s) in q.fixed.iter_mut().zip(&sums).take(q.n_owned) {
             add_assign(f, s);

@@ -219,7 +219,7 @@ fn bonds<M: Model>(
         scene.spacing,
         scene.partial_volume,
     );
-    crate::engine::forces::add_bond_fixed(model, particles, &bonds);
+    crate::engine::bond_sums::add_bond_fixed(model, particles, &bonds);
     let correction = if scene.surface_correction {
         if <M::State as Attributes>::LEN > 0 {
             return Err(scene.error(
