@@ -4,6 +4,8 @@
 //! owner; the model returns the generalized force on both ends and the loop adds them, so
 //! equal-and-opposite forces and unequal micropolar moments go through the same code.
 
+use std::marker::PhantomData;
+
 use crate::engine::bond_geoms::GeomSlice;
 use crate::engine::bonds::BondList;
 use crate::engine::particles::Particles;
@@ -346,6 +348,13 @@ where
             state: state.get_unchecked(j),
         }
     };
+    let mut sweeper = Sweeper::<M, T, _, L, V, DAMAGE> {
+        side,
+        laws,
+        visit,
+        out,
+        model: PhantomData,
+    };
     let mut newly_broken = 0;
     for i in 0..n_owned {
         // Local copies: the compiler cannot tell that the stores into `out` below leave
@@ -368,10 +377,9 @@ where
             history: &mut history[range],
         };
         // SAFETY: the partners are in bounds of `out` and of `side`, as above.
-        let (oi, broke) =
-            unsafe { family.sweep::<T, L, V, _, DAMAGE>(&owner, &side, &laws, &visit, out) };
+        let (oi, broke) = unsafe { sweeper.family(&owner, family) };
         newly_broken += broke;
-        add_assign(&mut out[i], &oi);
+        add_assign(&mut sweeper.out[i], &oi);
     }
     newly_broken
 }
@@ -384,7 +392,25 @@ struct Family<'a, M: Model> {
     history: &'a mut [M::Bond],
 }
 
-impl<M: Model> Family<'_, M> {
+/// What stays the same through one sweep: how a partner is read (`side`), where the laws come
+/// from, what the model is asked for each bond (`visit`), and the records the partners'
+/// contributions go into (`out`).
+struct Sweeper<'o, M, T, S, L, V, const DAMAGE: bool> {
+    side: S,
+    laws: L,
+    visit: V,
+    out: &'o mut [T],
+    model: PhantomData<fn() -> M>,
+}
+
+impl<'s, M, T, S, L, V, const DAMAGE: bool> Sweeper<'_, M, T, S, L, V, DAMAGE>
+where
+    M: Model + 's,
+    T: Attributes,
+    S: Fn(usize) -> Side<'s, M>,
+    L: Laws<M>,
+    V: BondVisit<M, T>,
+{
     /// Visits the family's intact bonds in bond order, adding each partner's contribution into
     /// `out`; returns the owner's sum and how many bonds broke. Four bonds go at once if the
     /// model asks (`Model::BOND_LANES`) and the next four are intact, as one lane group;
@@ -394,27 +420,13 @@ impl<M: Model> Family<'_, M> {
     /// # Safety
     /// Every partner is below `out.len()` and is a particle `side` may read.
     #[inline(always)]
-    unsafe fn sweep<'s, T, L, V, S, const DAMAGE: bool>(
-        mut self,
-        owner: &Side<'_, M>,
-        side: &S,
-        laws: &L,
-        visit: &V,
-        out: &mut [T],
-    ) -> (T, usize)
-    where
-        T: Attributes,
-        L: Laws<M>,
-        V: BondVisit<M, T>,
-        S: Fn(usize) -> Side<'s, M>,
-        M: 's,
-    {
+    unsafe fn family(&mut self, owner: &Side<'_, M>, mut family: Family<'_, M>) -> (T, usize) {
         // The owner's sum: in `oi`, or in `lane_sum` while lane groups run.
         let mut oi = T::default();
         let mut lane_sum = OwnerSum::from(&oi);
         let mut in_lanes = M::BOND_LANES == LANES;
         let mut newly_broken = 0;
-        let len = self.partner.len();
+        let len = family.partner.len();
         let mut k = 0;
         while k < len {
             let mut end = k + 1;
@@ -425,12 +437,12 @@ impl<M: Model> Family<'_, M> {
                 }
                 let group = Group {
                     owner,
-                    js: std::array::from_fn(|l| self.partner[k + l] as usize),
-                    geoms: std::array::from_fn(|l| self.geom.get(k + l)),
+                    js: std::array::from_fn(|l| family.partner[k + l] as usize),
+                    geoms: std::array::from_fn(|l| family.geom.get(k + l)),
                 };
-                let intact = !DAMAGE || !self.broken[k..k + LANES].iter().any(|&b| b);
+                let intact = !DAMAGE || !family.broken[k..k + LANES].iter().any(|&b| b);
                 // SAFETY: the caller keeps the partners in bounds.
-                if intact && unsafe { group.run(visit, laws, side, &mut lane_sum, out) } {
+                if intact && unsafe { self.group(&group, &mut lane_sum) } {
                     k += LANES;
                     continue;
                 }
@@ -441,17 +453,7 @@ impl<M: Model> Family<'_, M> {
                 in_lanes = false;
             }
             // SAFETY: the caller keeps the partners in bounds.
-            newly_broken += unsafe {
-                self.one_by_one::<T, L, V, S, DAMAGE>(
-                    k..end,
-                    owner,
-                    side,
-                    laws,
-                    visit,
-                    &mut oi,
-                    out,
-                )
-            };
+            newly_broken += unsafe { self.one_by_one(owner, &mut family, k..end, &mut oi) };
             k = end;
         }
         if in_lanes {
@@ -460,48 +462,63 @@ impl<M: Model> Family<'_, M> {
         (oi, newly_broken)
     }
 
-    /// Visits the intact bonds of `bonds` one at a time, adding into the owner's sum `oi` and
-    /// the partners' records in `out`, or breaking them; returns how many broke.
+    /// Visits the intact bonds `bonds` of `family` one at a time, adding into the owner's sum
+    /// `oi` and the partners' records, or breaking them; returns how many broke.
     ///
     /// # Safety
-    /// As [`Family::sweep`].
+    /// As [`Sweeper::family`].
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn one_by_one<'s, T, L, V, S, const DAMAGE: bool>(
+    unsafe fn one_by_one(
         &mut self,
-        bonds: std::ops::Range<usize>,
         owner: &Side<'_, M>,
-        side: &S,
-        laws: &L,
-        visit: &V,
+        family: &mut Family<'_, M>,
+        bonds: std::ops::Range<usize>,
         oi: &mut T,
-        out: &mut [T],
-    ) -> usize
-    where
-        T: Attributes,
-        L: Laws<M>,
-        V: BondVisit<M, T>,
-        S: Fn(usize) -> Side<'s, M>,
-        M: 's,
-    {
+    ) -> usize {
         let mut newly_broken = 0;
         for k in bonds {
-            if DAMAGE && self.broken[k] {
+            if DAMAGE && family.broken[k] {
                 continue;
             }
-            let j = self.partner[k] as usize;
-            let sj = side(j);
-            let law = laws.of(owner.material, sj.material);
-            let r = visit.visit(&law, owner, &sj, self.geom.get(k), &mut self.history[k]);
+            let j = family.partner[k] as usize;
+            let sj = (self.side)(j);
+            let law = self.laws.of(owner.material, sj.material);
+            let geom = family.geom.get(k);
+            let r = self
+                .visit
+                .visit(&law, owner, &sj, geom, &mut family.history[k]);
             // SAFETY: the caller keeps the partners in bounds.
             newly_broken += add_or_break::<T, DAMAGE>(
                 r,
                 oi,
-                unsafe { out.get_unchecked_mut(j) },
-                &mut self.broken[k],
+                unsafe { self.out.get_unchecked_mut(j) },
+                &mut family.broken[k],
             );
         }
         newly_broken
+    }
+
+    /// Runs a lane group through the model's lane law and adds its forces to the owner's sum
+    /// `oi` and to the partners; false (nothing added) if the model refuses it.
+    ///
+    /// # Safety
+    /// Every partner in the group is below `out.len()` and is a particle `side` may read.
+    #[inline(always)]
+    unsafe fn group(&mut self, group: &Group<'_, M>, oi: &mut OwnerSum) -> bool {
+        let sides = group.js.map(&self.side);
+        let materials = sides.each_ref().map(|s| s.material);
+        let visit = &self.visit;
+        let forces = self.laws.group(group.owner.material, materials, |laws| {
+            visit.visit_lanes(laws, group.owner, sides.each_ref(), group.geoms)
+        });
+        match forces {
+            Some(f) => {
+                // SAFETY: the caller keeps the partners in bounds.
+                unsafe { add_lanes(oi, self.out, group.js, &f) };
+                true
+            }
+            None => false,
+        }
     }
 }
 
@@ -559,44 +576,6 @@ struct Group<'a, M: Model> {
     owner: &'a Side<'a, M>,
     js: [usize; LANES],
     geoms: [&'a BondGeom; LANES],
-}
-
-impl<M: Model> Group<'_, M> {
-    /// Runs the group through the model's lane law and adds its forces to the owner's sum
-    /// `oi` and to the partners in `out`; false (nothing added) if the model refuses it.
-    ///
-    /// # Safety
-    /// Every partner in `js` is below `out.len()` and is a particle `side` may read.
-    #[inline(always)]
-    unsafe fn run<'s, T, V, L, S>(
-        &self,
-        visit: &V,
-        laws: &L,
-        side: &S,
-        oi: &mut OwnerSum,
-        out: &mut [T],
-    ) -> bool
-    where
-        T: Attributes,
-        V: BondVisit<M, T>,
-        L: Laws<M>,
-        S: Fn(usize) -> Side<'s, M>,
-        M: 's,
-    {
-        let sides = self.js.map(side);
-        let materials = sides.each_ref().map(|s| s.material);
-        let forces = laws.group(self.owner.material, materials, |laws| {
-            visit.visit_lanes(laws, self.owner, sides.each_ref(), self.geoms)
-        });
-        match forces {
-            Some(f) => {
-                // SAFETY: the caller keeps the partners in bounds.
-                unsafe { add_lanes(oi, out, self.js, &f) };
-                true
-            }
-            None => false,
-        }
-    }
 }
 
 /// Adds a bond's contributions to its two ends, or marks it broken; returns how many broke.
