@@ -173,6 +173,7 @@ fn solver_choice<M: Model>(
             max_iterations,
             method,
             krylov_iterations,
+            coarse,
             ..
         } => {
             let newton = method != Equilibrium::Relaxation;
@@ -186,6 +187,7 @@ fn solver_choice<M: Model>(
                         diagonal: crate::solve::krylov::Diagonal::of(&setup.sim),
                         max_iterations: krylov_iterations,
                         always: method == Equilibrium::NewtonKrylov,
+                        coarse,
                     },
                 }
             } else {

@@ -355,7 +355,7 @@ const DIAGONAL_SHIFT: f64 = 1e-6;
 /// finite-difference perturbation and not under the other; the shifted matrix is a slightly
 /// stiffer tangent, which modified Newton converges with, where an LU of a 3D lattice's
 /// matrix takes minutes (its column ordering alone).
-fn shifted_cholesky(
+pub(super) fn shifted_cholesky(
     triplets: &[Triplet<usize, usize, f64>],
     free: usize,
 ) -> Option<faer::sparse::linalg::solvers::Llt<usize, f64>> {

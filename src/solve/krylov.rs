@@ -11,11 +11,14 @@
 //! gives the same bits). The memory is a few vectors of the free DOFs, where the factored
 //! tangent of a 20,787-particle micropolar beam took 14.5 GB.
 //!
-//! The preconditioner is diagonal: the Gershgorin shape b_i = V_i Σ_j V_j C_ij that ADR's
-//! fictitious masses are made of ([`crate::solve::adr::gershgorin_shape`]), computed once on
-//! the whole scene before it is cut into procCubes. It puts translations and rotations, surface
-//! and interior particles on one scale; CG's iterations still grow with the beam's slenderness
-//! (about √κ of a bending problem).
+//! The preconditioner has two levels. The first is diagonal: the Gershgorin shape
+//! b_i = V_i Σ_j V_j C_ij that ADR's fictitious masses are made of
+//! ([`crate::solve::adr::gershgorin_shape`]), computed once on the whole scene before it is cut
+//! into procCubes. It puts translations and rotations, surface and interior particles on one
+//! scale, but alone it leaves CG's iterations growing with the beam's slenderness (about √κ
+//! of a bending problem). The second, where the deck keeps it (`[solver] preconditioner`),
+//! solves exactly for the rigid motions of groups of particles ([`crate::solve::coarse`]),
+//! which is where a beam's bending lives.
 //!
 //! The step h makes the largest move of any DOF [`DIFFERENCE_STEP`] of the shortest bond
 //! (radians for rotations): the truncation error of the difference is then about 1e-7 of the
@@ -30,6 +33,7 @@ use crate::model::attributes::Attributes;
 use crate::model::{second_order, Model};
 use crate::parallel::comm::Reduce;
 use crate::parallel::Cube;
+use crate::solve::coarse::Coarse;
 use std::time::Instant;
 
 /// The largest move of a DOF in a difference product, relative to the shortest bond (lengths)
@@ -87,13 +91,24 @@ pub struct Solved {
     /// |F − K δ| at the end, in the units of the force.
     pub residual: f64,
     pub converged: bool,
+    /// Force evaluations that measured the coarse level's matrix (0: kept or none).
+    pub coarse_evaluations: u64,
     /// CG met a direction of zero or negative curvature (a tangent that is not positive
     /// definite: a softening crack, a mechanism) and stopped there.
     pub indefinite: bool,
 }
 
+/// CG's preconditioner: the diagonal and the coarse level, if the solve keeps one. With
+/// `rebuild` (the start of a load step) the coarse level is measured anew at the current state
+/// into `coarse`; otherwise it is used as it is.
+pub struct Preconditioner<'a> {
+    pub diagonal: &'a Diagonal,
+    pub coarse: &'a mut Option<Coarse>,
+    pub rebuild: bool,
+}
+
 /// The state a difference product starts from and returns to.
-struct Base<M: Model> {
+pub(super) struct Base<M: Model> {
     alter: Vec<M::Alter>,
     broken: Vec<bool>,
     history: Vec<M::Bond>,
@@ -144,7 +159,7 @@ fn dots(cube: &mut Cube<impl Model>, pairs: &[(&[f64], &[f64])]) -> Vec<f64> {
 
 /// `out` = K·v on the owned DOFs by one forward difference of the force (module comment);
 /// zero on supported DOFs. The scene is left as `base` holds it.
-fn tangent_times<M: Model>(
+pub(super) fn tangent_times<M: Model>(
     cube: &mut Cube<M>,
     base: &Base<M>,
     v: &[f64],
@@ -195,15 +210,23 @@ fn tangent_times<M: Model>(
 /// Every procCube must call it alike.
 pub fn solve<M: Model>(
     cube: &mut Cube<M>,
-    diagonal: &Diagonal,
+    precondition: Preconditioner<'_>,
     force: &[f64],
     target: f64,
     max_iterations: u64,
 ) -> (Vec<f64>, Solved) {
     let t = Instant::now();
     let free = cube.sim.free_dofs();
-    let inverse = diagonal.inverse(cube, &free);
+    let inverse = precondition.diagonal.inverse(cube, &free);
     let base = Base::new(cube, force);
+    let mut solved = Solved::default();
+    if precondition.rebuild {
+        cube.sim.timing.lap(Phase::Integration, t);
+        *precondition.coarse = Coarse::build(cube, &base, &free);
+        solved.coarse_evaluations = precondition.coarse.as_ref().map_or(0, |c| c.evaluations);
+    }
+    let t = Instant::now();
+    let coarse = precondition.coarse.as_ref();
     let len = force.len();
     let mut x = vec![0.0; len];
     let mut r: Vec<f64> = force
@@ -212,11 +235,13 @@ pub fn solve<M: Model>(
         .map(|(&f, &ok)| if ok { f } else { 0.0 })
         .collect();
     let mut z: Vec<f64> = r.iter().zip(&inverse).map(|(a, b)| a * b).collect();
+    if let Some(c) = coarse {
+        c.correct(cube, &free, &r, &mut z);
+    }
     let mut p = z.clone();
     let mut q = vec![0.0; len];
     let sums = dots(cube, &[(&r, &z), (&r, &r)]);
     let (mut rz, mut rr) = (sums[0], sums[1]);
-    let mut solved = Solved::default();
     cube.sim.timing.lap(Phase::Integration, t);
     while rr.sqrt() > target && solved.iterations < max_iterations {
         tangent_times(cube, &base, &p, &free, &mut q);
@@ -233,6 +258,9 @@ pub fn solve<M: Model>(
             x[idx] += alpha * p[idx];
             r[idx] -= alpha * q[idx];
             z[idx] = r[idx] * inverse[idx];
+        }
+        if let Some(c) = coarse {
+            c.correct(cube, &free, &r, &mut z);
         }
         let sums = dots(cube, &[(&r, &z), (&r, &r)]);
         let beta = sums[0] / rz;

@@ -8,6 +8,7 @@
 //! scene.
 
 pub mod adr;
+pub mod coarse;
 pub mod implicit;
 pub mod krylov;
 pub mod newton;

@@ -23,7 +23,8 @@ use crate::parallel::comm::Reduce;
 use crate::parallel::Cube;
 use crate::solve::adr::{begin_load_step, zero_velocities, Relaxed};
 use crate::solve::implicit::{assemble_tangent, NoTangent, Tangent};
-use crate::solve::krylov::{self, Diagonal};
+use crate::solve::coarse::Coarse;
+use crate::solve::krylov::{self, Diagonal, Preconditioner};
 use crate::solve::Solver;
 use std::time::Instant;
 
@@ -41,6 +42,9 @@ pub struct MatrixFree {
     pub max_iterations: u64,
     /// Matrix-free from the start (`"newton_krylov"`), not only where the factor cannot serve.
     pub always: bool,
+    /// Whether CG's preconditioner has the coarse level of rigid group motions
+    /// (`[solver] preconditioner = "two_level"`, the default) or the diagonal alone.
+    pub coarse: bool,
 }
 
 /// Newton's method (module comment).
@@ -56,6 +60,9 @@ pub struct Newton {
     /// Whether this worker says when the solve turns matrix-free (the root only).
     report: bool,
     tangent: Option<Tangent>,
+    /// The coarse level of the matrix-free solve's preconditioner, measured at the start of
+    /// each load step.
+    coarse: Option<Coarse>,
     /// CG iterations of every load step so far.
     pub krylov_iterations: u64,
 }
@@ -71,6 +78,7 @@ impl Newton {
             krylov: false,
             report: false,
             tangent: None,
+            coarse: None,
             krylov_iterations: 0,
         }
     }
@@ -135,7 +143,8 @@ impl Newton {
             let last = std::mem::replace(&mut previous, residual);
             let step = if self.krylov {
                 let target = (FORCING * norm).max(0.5 * self.tolerance * scale);
-                let Some((step, spent)) = self.krylov_step(cube, &force, target) else {
+                let Some((step, spent)) = self.krylov_step(cube, &force, target, newton == 0)
+                else {
                     break residual;
                 };
                 evaluations += spent;
@@ -184,17 +193,26 @@ impl Newton {
 
     /// The matrix-free step and the force evaluations it took; `None` when CG made no
     /// progress at all (a tangent with negative curvature along the preconditioned force).
+    /// The coarse level is measured at the first iteration of a load step (`first`): a
+    /// function of the step's starting state alone, so a resumed run measures what the
+    /// uninterrupted one did.
     fn krylov_step<M: Model>(
         &mut self,
         cube: &mut Cube<M>,
         force: &[f64],
         target: f64,
+        first: bool,
     ) -> Option<(Vec<f64>, u64)> {
         let mf = self
             .matrix_free
             .as_ref()
             .expect("matrix-free with a preconditioner");
-        let (step, solved) = krylov::solve(cube, &mf.diagonal, force, target, mf.max_iterations);
+        let precondition = Preconditioner {
+            diagonal: &mf.diagonal,
+            coarse: &mut self.coarse,
+            rebuild: mf.coarse && first,
+        };
+        let (step, solved) = krylov::solve(cube, precondition, force, target, mf.max_iterations);
         self.krylov_iterations += solved.iterations;
         if solved.indefinite && self.report {
             eprintln!(
@@ -203,7 +221,7 @@ impl Newton {
             );
         }
         (solved.iterations > 0 && step.iter().any(|&d| d != 0.0))
-            .then_some((step, solved.iterations))
+            .then_some((step, solved.iterations + solved.coarse_evaluations))
     }
 }
 

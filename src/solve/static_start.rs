@@ -73,6 +73,7 @@ pub fn solve<M: Model>(setup: &Setup<M>, until: f64, walls: Walls) -> Result<Sta
         diagonal: crate::solve::krylov::Diagonal::of(&setup.sim),
         max_iterations: crate::input::deck::DEFAULT_KRYLOV_ITERATIONS,
         always: false,
+        coarse: true,
     };
     let mut newton = Newton::new(TOLERANCE, MAX_ITERATIONS, 0).with_matrix_free(matrix_free, false);
     let r = newton

@@ -64,6 +64,7 @@ pub(super) struct SolverSection {
     pub(super) tolerance: Option<f64>,
     pub(super) max_iterations: Option<u64>,
     pub(super) krylov_iterations: Option<u64>,
+    pub(super) preconditioner: Option<String>,
 }
 
 /// `procs` is `[nx, ny, nz]` or `"auto"`.

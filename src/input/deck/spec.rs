@@ -183,6 +183,9 @@ pub enum SolverSpec {
         method: Equilibrium,
         /// Conjugate-gradient iterations per Newton iteration of the matrix-free solve.
         krylov_iterations: u64,
+        /// Whether the matrix-free solve's preconditioner has its coarse level
+        /// (`preconditioner = "two_level"`) or is the diagonal alone (`"diagonal"`).
+        coarse: bool,
     },
 }
 

@@ -169,8 +169,9 @@ impl Converter {
                     || s.tolerance.is_some()
                     || s.max_iterations.is_some()
                     || s.krylov_iterations.is_some()
+                    || s.preconditioner.is_some()
                 {
-                    return self.err(line, "[solver] load_steps, tolerance, max_iterations and krylov_iterations belong to kind = \"adr\", \"implicit\" or \"newton_krylov\"");
+                    return self.err(line, "[solver] load_steps, tolerance, max_iterations, krylov_iterations and preconditioner belong to kind = \"adr\", \"implicit\" or \"newton_krylov\"");
                 }
                 SolverSpec::Explicit
             }
@@ -184,6 +185,16 @@ impl Converter {
                 if !newton && s.krylov_iterations.is_some() {
                     return self.err(line, "[solver] krylov_iterations belongs to kind = \"implicit\" or \"newton_krylov\" (the conjugate-gradient iterations of the matrix-free solve)");
                 }
+                if !newton && s.preconditioner.is_some() {
+                    return self.err(line, "[solver] preconditioner belongs to kind = \"implicit\" or \"newton_krylov\" (the matrix-free solve's conjugate gradients)");
+                }
+                let coarse = match s.preconditioner.as_deref() {
+                    None | Some("two_level") => true,
+                    Some("diagonal") => false,
+                    Some(other) => {
+                        return self.err(line, format!("[solver] preconditioner '{other}' is not one (use \"two_level\", the diagonal with a coarse level of rigid group motions, or \"diagonal\")"));
+                    }
+                };
                 let load_steps = s.load_steps.unwrap_or(10);
                 let tolerance = s.tolerance.unwrap_or(if newton { 1e-8 } else { 1e-4 });
                 let max_iterations = s
@@ -210,6 +221,7 @@ impl Converter {
                     max_iterations,
                     method,
                     krylov_iterations,
+                    coarse,
                 }
             }
             other => {
