@@ -578,6 +578,30 @@ fn measured_critical_step_with_relaxation() {
     );
 }
 
+/// A preconditioner the matrix-free solve does not have, and one given to ADR (which has no
+/// linear solve to precondition).
+#[test]
+fn unknown_or_misplaced_preconditioner() {
+    let unknown = edit("safety_factor = 0.8", "safety_factor = 0.8")
+        + "[solver]\nkind = \"newton_krylov\"\npreconditioner = \"multigrid\"\n";
+    let line = line_of(&unknown, "[solver]");
+    assert_rejected(
+        "preconditioner_unknown",
+        &unknown,
+        &["preconditioner", "multigrid", "two_level", "diagonal"],
+        Some(line),
+    );
+    let misplaced = edit("safety_factor = 0.8", "safety_factor = 0.8")
+        + "[solver]\nkind = \"adr\"\npreconditioner = \"diagonal\"\n";
+    let line = line_of(&misplaced, "[solver]");
+    assert_rejected(
+        "preconditioner_adr",
+        &misplaced,
+        &["preconditioner", "newton_krylov"],
+        Some(line),
+    );
+}
+
 /// The measured critical step is accepted, shown by `pdq check` with the bound, and above it
 /// (the bound is 1.4–2.4× below the limit, docs/stability.md); a dt between the two passes.
 #[test]

@@ -102,35 +102,51 @@ impl Coarse {
         })
     }
 
-    /// z += P K_c⁻¹ Pᵀ r over the free owned DOFs (Pᵀ r summed over every procCube).
+    /// z += P K_c⁻¹ Pᵀ r over the free owned DOFs (Pᵀ r summed over every procCube). Written
+    /// out, not through [`Groups::motion`]: it runs at every CG iteration. A translation t and
+    /// rotation θ of a group move its particle at offset d by t + θ × d (and turn a micropolar
+    /// one by θ / H); so (Pᵀ r) of a group gathers Σ r and Σ d × r.
     pub fn correct<M: Model>(&self, cube: &mut Cube<M>, free: &[bool], r: &[f64], z: &mut [f64]) {
         let g = &self.groups;
         let n2 = g.n2;
-        let size = self.dead.len();
-        let mut rc = vec![0.0; size];
-        for (i, &b) in g.group.iter().enumerate() {
-            for m in 0..MOTIONS {
-                rc[b * MOTIONS + m] += (0..n2)
-                    .map(|k| g.motion(i, k, m) * r[i * n2 + k])
-                    .sum::<f64>();
+        let mut rc = vec![0.0; self.dead.len()];
+        for (i, (&b, d)) in g.group.iter().zip(&g.offset).enumerate() {
+            let f = &r[i * n2..i * n2 + n2];
+            let c = &mut rc[b * MOTIONS..b * MOTIONS + MOTIONS];
+            let turn = cross(d, &[f[0], f[1], f[2]]);
+            for a in 0..3 {
+                c[a] += f[a];
+                c[3 + a] += turn[a] + if n2 == 6 { g.inv_h * f[3 + a] } else { 0.0 };
             }
         }
         cube.team().reduce(&mut rc, Reduce::Sum);
-        let mut y = faer::Mat::<f64>::zeros(size, 1);
+        let mut y = faer::Mat::<f64>::zeros(rc.len(), 1);
         for (row, (&v, &dead)) in rc.iter().zip(&self.dead).enumerate() {
+            // The dead rows are decoupled in K_c: a zero here stays zero.
             y[(row, 0)] = if dead { 0.0 } else { v };
         }
         self.factor.solve_in_place(y.as_mut());
-        for (i, &b) in g.group.iter().enumerate() {
-            for k in (0..n2).filter(|&k| free[i * n2 + k]) {
-                let moved: f64 = (0..MOTIONS)
-                    .filter(|&m| !self.dead[b * MOTIONS + m])
-                    .map(|m| g.motion(i, k, m) * y[(b * MOTIONS + m, 0)])
-                    .sum();
-                z[i * n2 + k] += moved;
+        for (i, (&b, d)) in g.group.iter().zip(&g.offset).enumerate() {
+            let c: [f64; MOTIONS] = std::array::from_fn(|m| y[(b * MOTIONS + m, 0)]);
+            let turn = cross(&[c[3], c[4], c[5]], d);
+            for a in 0..3 {
+                if free[i * n2 + a] {
+                    z[i * n2 + a] += c[a] + turn[a];
+                }
+                if n2 == 6 && free[i * n2 + 3 + a] {
+                    z[i * n2 + 3 + a] += g.inv_h * c[3 + a];
+                }
             }
         }
     }
+}
+
+fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 impl Groups {

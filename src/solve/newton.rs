@@ -136,7 +136,7 @@ impl Newton {
             let residual = norm / scale.max(f64::MIN_POSITIVE);
             if residual <= self.tolerance
                 || newton >= self.max_iterations
-                || (self.stop_at_broken > 0 && cube.broken_count() as u64 >= self.stop_at_broken)
+                || (self.stop_at_broken > 0 && broken_bonds(cube) >= self.stop_at_broken)
             {
                 break residual;
             }
@@ -220,7 +220,10 @@ impl Newton {
                 solved.iterations
             );
         }
-        (solved.iterations > 0 && step.iter().any(|&d| d != 0.0))
+        // Whether any procCube moves: every one must take the same branch.
+        let mut moves = [f64::from(u8::from(step.iter().any(|&d| d != 0.0)))];
+        cube.team().reduce(&mut moves, Reduce::Max);
+        (solved.iterations > 0 && moves[0] > 0.0)
             .then_some((step, solved.iterations + solved.coarse_evaluations))
     }
 }
@@ -246,6 +249,14 @@ fn residual_force<M: Model>(cube: &mut Cube<M>, force: &mut Vec<f64>) -> (f64, f
     let scale = sums[1..].iter().map(|x| x * x).sum::<f64>().sqrt();
     cube.sim.timing.lap(Phase::Integration, t);
     (sums[0].sqrt(), scale)
+}
+
+/// The bonds broken on every procCube (as `[time] stop_at_broken_bonds` counts them), so that
+/// every one stops at the same iteration.
+fn broken_bonds<M: Model>(cube: &mut Cube<M>) -> u64 {
+    let mut n = [cube.broken_count() as f64];
+    cube.team().reduce(&mut n, Reduce::Sum);
+    n[0] as u64
 }
 
 /// u += δ on the owned particles, through the model's drift (rotations compose).
