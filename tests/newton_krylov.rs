@@ -76,8 +76,14 @@ fn the_coarse_level_cuts_the_iterations_and_keeps_the_deflection() {
         let (solver, quick) = (ElasticSolver::NewtonKrylov, Level::Quick);
         let two_level = load_with(&path, quick, solver, None).unwrap();
         let diagonal = load_with(&path, quick, solver, Some(&diagonal_only)).unwrap();
-        assert!(two_level.deck.contains("kind = \"newton_krylov\""), "{name}: matrix-free");
-        assert!(diagonal.deck.contains("preconditioner = \"diagonal\""), "{name}");
+        assert!(
+            two_level.deck.contains("kind = \"newton_krylov\""),
+            "{name}: matrix-free"
+        );
+        assert!(
+            diagonal.deck.contains("preconditioner = \"diagonal\""),
+            "{name}"
+        );
         let a = validate::run_case(&two_level, &out(&format!("{name}-two-level")), 1).unwrap();
         let b = validate::run_case(&diagonal, &out(&format!("{name}-diagonal")), 1).unwrap();
         let difference = (a.measured - b.measured).abs() / b.measured.abs();
@@ -85,7 +91,11 @@ fn the_coarse_level_cuts_the_iterations_and_keeps_the_deflection() {
             "{name}: two levels {:.10e} in {} evaluations, diagonal {:.10e} in {}: {difference:.1e} apart",
             a.measured, a.force_evaluations, b.measured, b.force_evaluations
         );
-        assert_eq!((a.converged, b.converged), (Some(true), Some(true)), "{name}");
+        assert_eq!(
+            (a.converged, b.converged),
+            (Some(true), Some(true)),
+            "{name}"
+        );
         assert!(difference <= 1e-6, "{name}: {difference:e} apart");
         assert!(
             2 * a.force_evaluations < b.force_evaluations,

@@ -70,7 +70,9 @@ struct Grid {
 
 impl Grid {
     fn cell(&self, x: &[f64; 3]) -> [usize; 3] {
-        std::array::from_fn(|a| (((x[a] - self.lo[a]) / self.h).floor().max(0.0) as usize).min(self.dims[a] - 1))
+        std::array::from_fn(|a| {
+            (((x[a] - self.lo[a]) / self.h).floor().max(0.0) as usize).min(self.dims[a] - 1)
+        })
     }
     fn index(&self, c: [usize; 3]) -> usize {
         c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])
@@ -85,7 +87,11 @@ impl Coarse {
     /// Measures and factors the coarse level at the state `base` holds; `None` where the
     /// model's DOFs are not a displacement (and a rotation) or the coarse matrix cannot be
     /// factored: the preconditioner is then the diagonal alone. Every procCube calls it alike.
-    pub(super) fn build<M: Model>(cube: &mut Cube<M>, base: &Base<M>, free: &[bool]) -> Option<Coarse> {
+    pub(super) fn build<M: Model>(
+        cube: &mut Cube<M>,
+        base: &Base<M>,
+        free: &[bool],
+    ) -> Option<Coarse> {
         let n2 = second_order::<M>();
         if n2 != 3 && n2 != 6 {
             return None;
@@ -268,9 +274,7 @@ impl Groups {
                     let Some(o) = *o else { continue };
                     let row = (self.group[i] * AROUND + o) * MOTIONS * MOTIONS;
                     for j in 0..MOTIONS {
-                        let s: f64 = (0..n2)
-                            .map(|k| self.motion(i, k, j) * q[i * n2 + k])
-                            .sum();
+                        let s: f64 = (0..n2).map(|k| self.motion(i, k, j) * q[i * n2 + k]).sum();
                         measured[row + j * MOTIONS + m] += s;
                     }
                 }
@@ -309,7 +313,11 @@ impl Groups {
             for o in 0..AROUND {
                 let step = [o % 3, o / 3 % 3, o / 9];
                 let at: Option<Vec<usize>> = (0..3)
-                    .map(|a| (c[a] + step[a]).checked_sub(1).filter(|&x| x < grid.dims[a]))
+                    .map(|a| {
+                        (c[a] + step[a])
+                            .checked_sub(1)
+                            .filter(|&x| x < grid.dims[a])
+                    })
                     .collect();
                 let Some(at) = at else { continue };
                 let a = number[grid.index([at[0], at[1], at[2]])];
@@ -328,8 +336,13 @@ impl Groups {
                 }
             }
         }
-        triplets.extend((0..size).filter(|&r| dead[r]).map(|r| Triplet::new(r, r, 1.0)));
-        let lower = SparseColMat::<usize, f64>::try_new_from_triplets(size, size, &triplets).ok()?;
+        triplets.extend(
+            (0..size)
+                .filter(|&r| dead[r])
+                .map(|r| Triplet::new(r, r, 1.0)),
+        );
+        let lower =
+            SparseColMat::<usize, f64>::try_new_from_triplets(size, size, &triplets).ok()?;
         let factor = (lower.sp_cholesky(faer::Side::Lower).ok())
             .or_else(|| crate::solve::implicit::shifted_cholesky(&triplets, size))?;
         Some((dead, factor))
@@ -374,13 +387,26 @@ fn grid<M: Model>(cube: &mut Cube<M>) -> Option<Grid> {
         shortest = shortest.min(g.length);
         neg_longest = neg_longest.min(-g.length);
     }
-    let mut all = [lo[0], lo[1], lo[2], neg_hi[0], neg_hi[1], neg_hi[2], shortest, neg_longest];
+    let mut all = [
+        lo[0],
+        lo[1],
+        lo[2],
+        neg_hi[0],
+        neg_hi[1],
+        neg_hi[2],
+        shortest,
+        neg_longest,
+    ];
     cube.team().reduce(&mut all, Reduce::Min);
     let longest = -all[7];
     if !(all[6].is_finite() && longest > 0.0) {
         return None;
     }
-    let reach = if <M::State as Attributes>::LEN > 0 { 2.0 * longest } else { longest };
+    let reach = if <M::State as Attributes>::LEN > 0 {
+        2.0 * longest
+    } else {
+        longest
+    };
     let h = (GROUP_SPACINGS * all[6]).max(reach * (1.0 + 1e-6));
     let lo = [all[0], all[1], all[2]];
     let dims = std::array::from_fn(|a| ((-all[3 + a] - lo[a]) / h).floor() as usize + 1);
