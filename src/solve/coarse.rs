@@ -256,8 +256,8 @@ impl Groups {
                 .map(|c| of_colour(c, tint, grid, number))
                 .collect();
             for m in 0..MOTIONS {
-                for i in 0..n {
-                    let moved = (0..3).all(|a| cells[i][a] % 3 == tint[a])
+                for (i, cell) in cells.iter().enumerate() {
+                    let moved = (0..3).all(|a| cell[a] % 3 == tint[a])
                         && (m < 3 || self.rotates[self.group[i]]);
                     for k in 0..n2 {
                         let idx = i * n2 + k;
