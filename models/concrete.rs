@@ -11,6 +11,8 @@
 //! Two different concrete (or steel) materials bond with the series stiffness and the tighter
 //! limits.
 
+use super::pmb::lane_positions;
+use crate::model::lanes::{LaneForces, Real, F4, LANES, MAX_COMPONENTS};
 use crate::model::{
     bond_based_lame, check_options, stretch, BondGeom, Dimension, Material, MaterialKind, Model,
     ModelBuild, ModelError, PairTable, Sample, SampleOf, Side,
@@ -84,6 +86,38 @@ impl Concrete {
             }
         }
     }
+
+    /// The brittle laws' (c, tensile, compressive) of four lanes, or `None` if any lane's law
+    /// is plastic: a steel bond's plastic stretch is bond history, which only `pair` keeps.
+    #[inline(always)]
+    fn brittle_lanes(law: [&Law; LANES]) -> Option<[(f64, f64, f64); LANES]> {
+        let brittle = law.map(|l| match *l {
+            Law::Brittle {
+                c,
+                tensile,
+                compressive,
+            } => Some((c, tensile, compressive)),
+            Law::Plastic { .. } => None,
+        });
+        let [Some(a), Some(b), Some(c), Some(d)] = brittle else {
+            return None;
+        };
+        Some([a, b, c, d])
+    }
+}
+
+/// The bond's length r and elongation e = r − L (bond vector `y`), on one bond or four.
+#[inline(always)]
+fn elongation<T: Real>(y: &[T; 3], length: T) -> (T, T) {
+    let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+    (r - length, r)
+}
+
+/// The force on end i per unit bond vector, from c × the elastic elongation `ce`:
+/// ce·β·V_i·V_j/(L·r) (the 1/L of the stretch folded into the one division).
+#[inline(always)]
+fn factor<T: Real>(ce: T, beta: T, vi: T, vj: T, length: T, r: T) -> T {
+    ce * beta * vi * vj / (length * r)
 }
 
 /// The bond micromodulus of the thesis (eq. 4.1).
@@ -93,6 +127,9 @@ pub fn thesis_micromodulus(e: f64, nu: f64, delta: f64) -> f64 {
 
 impl Model for Concrete {
     const NAME: &'static str = "concrete";
+    // Concrete bonds (and concrete–steel ones) go four at a time; a group with a steel bond,
+    // whose plastic stretch is history, is refused and goes one by one.
+    const BOND_LANES: usize = LANES;
     const SUMMARY: &'static str =
         "thesis reinforced-concrete bonds: brittle concrete (s_c < s < s_t), elastic-plastic steel, x3 interface";
     const OPTIONS: &'static [(&'static str, &'static str)] = &[(
@@ -210,10 +247,10 @@ impl Model for Concrete {
     ) -> Option<(Force3, Force3)> {
         let (a, b) = (i.pos(), j.pos());
         let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
         let l = geom.length;
-        let ce = Self::coefficient(*law, r - l, l, &mut bond.plastic_stretch)?;
-        let f = ce * geom.beta * i.volume * j.volume / (l * r);
+        let (e, r) = elongation(&y, l);
+        let ce = Self::coefficient(*law, e, l, &mut bond.plastic_stretch)?;
+        let f = factor(ce, geom.beta, i.volume, j.volume, l, r);
         let fi = [f * y[0], f * y[1], f * y[2]];
         Some((
             Force3 { force: fi },
@@ -221,6 +258,41 @@ impl Model for Concrete {
                 force: [-fi[0], -fi[1], -fi[2]],
             },
         ))
+    }
+
+    /// Four brittle bonds through the same `elongation`, limits and `factor` as `pair`, one per
+    /// lane; `None` if any of them is a steel bond or breaks now.
+    #[inline(always)]
+    fn pair_lanes(
+        &self,
+        law: [&Law; LANES],
+        i: &Side<Self>,
+        j: [&Side<Self>; LANES],
+        geom: [&BondGeom; LANES],
+    ) -> Option<LaneForces> {
+        let law = Self::brittle_lanes(law)?;
+        let (a, b) = lane_positions(i, j);
+        let y = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let length = F4::gather(|l| geom[l].length);
+        let (e, r) = elongation(&y, length);
+        let tensile = F4::gather(|l| law[l].1) * length;
+        let compressive = F4::gather(|l| law[l].2) * length;
+        if e.any_outside(compressive, tensile) {
+            return None;
+        }
+        let f = factor(
+            F4::gather(|l| law[l].0) * e,
+            F4::gather(|l| geom[l].beta),
+            F4::splat(i.volume),
+            F4::gather(|l| j[l].volume),
+            length,
+            r,
+        );
+        let mut i = [F4::splat(0.0); MAX_COMPONENTS];
+        for k in 0..3 {
+            i[k] = f * y[k];
+        }
+        Some(LaneForces::opposite(i))
     }
 
     fn energy(
@@ -375,5 +447,103 @@ fn combine(a: Law, b: Law, factor: f64) -> Law {
             tensile: tensile * factor,
             compressive: compressive * factor,
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::attributes::Attributes;
+    use crate::model::lanes::fixture::{assert_same_bits, geom, moved, volume, X0};
+    use crate::model::material::PlainNumbers;
+    use crate::model::Written;
+
+    fn material(name: &str, index: u16, kind: MaterialKind, keys: &[(&str, f64)]) -> Material {
+        let keys = keys
+            .iter()
+            .map(|&(k, v)| (k.to_string(), Written::Number(v)))
+            .collect();
+        Material::new(name, index, kind, 2400.0, keys, &PlainNumbers).unwrap()
+    }
+
+    /// Two concretes and a steel: material 0 and 1 concrete (limits ±1 %, wider than the
+    /// fixture's stretches), 2 steel.
+    fn model() -> Concrete {
+        let concrete = |name, index, e| {
+            let keys = [
+                ("youngs_modulus", e),
+                ("poisson_ratio", 0.2),
+                ("tensile_stretch", 0.01),
+                ("compressive_stretch", -0.01),
+            ];
+            material(name, index, MaterialKind::Concrete, &keys)
+        };
+        let steel_keys = [
+            ("youngs_modulus", 200e9),
+            ("poisson_ratio", 0.3),
+            ("yield_stretch", 1e-4),
+        ];
+        let materials = [
+            concrete("a", 0, 30e9),
+            concrete("b", 1, 40e9),
+            material("s", 2, MaterialKind::Steel, &steel_keys),
+        ];
+        Concrete::build(&ModelBuild {
+            materials: &materials,
+            horizon: 3.015e-3,
+            spacing: 1e-3,
+            options: &[],
+        })
+        .unwrap()
+    }
+
+    /// `pair_lanes` gives `pair`'s forces bit for bit on concrete and concrete–steel bonds,
+    /// and refuses a group with a steel–steel bond (plastic history) or a bond past a limit.
+    #[test]
+    fn lanes_give_the_single_bond_forces_bit_for_bit() {
+        let m = model();
+        let alter: Vec<Motion> = (0..5)
+            .map(|p| Motion {
+                pos: moved(p),
+                vel: [0.0; 3],
+            })
+            .collect();
+        let run = |material: [u16; 5], alter: &[Motion]| {
+            let side = |p: usize| Side::<Concrete> {
+                x0: &X0[p],
+                volume: volume(p),
+                material: material[p],
+                alter: &alter[p],
+                fixed: &(),
+                state: &(),
+            };
+            let i = side(0);
+            let js = [side(1), side(2), side(3), side(4)];
+            let geoms = [geom(1), geom(2), geom(3), geom(4)];
+            let laws = js.each_ref().map(|j| m.law(i.material, j.material));
+            let lanes = m.pair_lanes(laws.each_ref(), &i, js.each_ref(), geoms.each_ref());
+            let single: Vec<Option<(Force3, Force3)>> = (0..LANES)
+                .map(|l| {
+                    let mut history = PlasticStretch::default();
+                    m.pair(&laws[l], &i, &js[l], &geoms[l], &mut history)
+                })
+                .collect();
+            (lanes, single)
+        };
+        // Concrete of two kinds and a concrete–steel interface bond, stretched and shortened.
+        let (lanes, single) = run([0, 1, 0, 2, 1], &alter);
+        let single: Vec<(Force3, Force3)> = single.into_iter().map(Option::unwrap).collect();
+        let pairs = std::array::from_fn(|l| (single[l].0.as_slice(), single[l].1.as_slice()));
+        assert_same_bits(&lanes.expect("no lane breaks"), pairs, "concrete");
+        // A steel–steel bond: refused, though `pair` takes it.
+        let (lanes, single) = run([2, 1, 0, 2, 1], &alter);
+        assert!(lanes.is_none() && single.iter().all(Option::is_some));
+        // Lane 2 stretched past the tensile limit, then shortened past the compressive one.
+        for push in [1e-4, -1e-4] {
+            let mut far = alter.clone();
+            far[3].pos[0] += push;
+            let (lanes, single) = run([0, 1, 0, 1, 1], &far);
+            assert!(lanes.is_none() && single[2].is_none(), "push {push}");
+        }
     }
 }

@@ -845,6 +845,22 @@ fn stop_at_zero_broken_bonds() {
     assert_rejected("stop_zero", &deck, &["stop_at_broken_bonds", ">= 1"], None);
 }
 
+/// A peak stop needs a fraction strictly between 0 and 1 (1 would stop at the first dip).
+#[test]
+fn a_peak_stop_fraction_outside_zero_to_one() {
+    for f in ["0", "1", "-0.5", "nan"] {
+        let stop =
+            format!("steps = 10\nstop_below_peak = {{ column = \"load_load\", fraction = {f} }}\n");
+        let deck = edit("steps = 10\n", &stop);
+        assert_rejected(
+            "peak_stop",
+            &deck,
+            &["stop_below_peak", "fraction in (0, 1)"],
+            None,
+        );
+    }
+}
+
 /// A probe's stop distance must be a positive length: a negative one would stop at once.
 #[test]
 fn a_probe_stop_of_negative_length() {

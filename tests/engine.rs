@@ -583,3 +583,118 @@ fn the_lane_sweep_gives_the_one_bond_forces_and_breaks() {
         "the crack must open during the compared passes: {passes_with_breaks} passes broke bonds, {broken} broken in all"
     );
 }
+
+/// The concrete model's lane sweep (four concrete or interface bonds at a time, steel bonds
+/// one by one) gives, pass after pass while a reinforced block cracks and its bar yields, the
+/// forces, broken flags and plastic stretches of `Model::pair` called bond by bond in bond
+/// order, bit for bit.
+#[test]
+fn the_concrete_lane_sweep_gives_the_one_bond_forces_history_and_breaks() {
+    use pdq::engine::forces::pair_pass;
+    use pdq::model::Model;
+    let text = r#"units = "SI"
+[model]
+name = "concrete"
+horizon = "3.015 mm"
+[lattice]
+spacing = "1 mm"
+[materials.concrete]
+kind = "concrete"
+density = "2400 kg/m^3"
+youngs_modulus = "30 GPa"
+poisson_ratio = 0.2
+tensile_stretch = 0.001
+compressive_stretch = -0.004
+[materials.steel]
+kind = "steel"
+density = "7850 kg/m^3"
+youngs_modulus = "200 GPa"
+poisson_ratio = 0.3
+yield_stretch = 0.0015
+[[geometry]]
+shape = "box"
+material = "concrete"
+min = "0 0 0 mm"
+max = "12 5 4 mm"
+[[bar]]
+material = "steel"
+area = "0.5 mm^2"
+from = "0.5 2.5 1.5 mm"
+to = "11.5 2.5 1.5 mm"
+[time]
+steps = 1
+[output]
+progress = false
+"#;
+    let scene = deck::parse(text, "test.toml", "test").expect("deck parses");
+    let mut s = build_as::<Concrete>(&scene).expect("setup builds");
+    let sim = &mut s.sim;
+    let (mut passes_with_breaks, mut yielded) = (0, false);
+    for t in 0..40 {
+        // The two halves pulled apart and squeezed across a little more at each pass.
+        for i in 0..sim.particles.len() {
+            let x0 = sim.particles.x0[i];
+            let side = if x0[0] < 6e-3 { -1.0 } else { 1.0 };
+            let a = 2e-7 * t as f64;
+            sim.particles.alter[i].pos = [
+                x0[0] + side * a,
+                x0[1] + 0.3 * a * x0[2] / 4e-3,
+                x0[2] - 0.2 * side * a,
+            ];
+        }
+        let (mut broken, mut history) = (sim.bonds.broken.clone(), sim.bonds.history.clone());
+        let before = broken.iter().filter(|&&b| b).count();
+        let mut force = vec![[0.0f64; 3]; sim.particles.len()];
+        let offsets = sim.bonds.offsets().to_vec();
+        for i in 0..offsets.len() - 1 {
+            let mut fi = [0.0; 3];
+            for b in offsets[i] as usize..offsets[i + 1] as usize {
+                let j = sim.bonds.partners()[b] as usize;
+                if broken[b] {
+                    continue;
+                }
+                let p = &sim.particles;
+                let law = sim.model.law(p.material[i], p.material[j]);
+                let geom = sim.bonds.geom[b];
+                match sim
+                    .model
+                    .pair(&law, &p.side(i), &p.side(j), &geom, &mut history[b])
+                {
+                    Some((a, c)) => (0..3).for_each(|k| {
+                        fi[k] += a.force[k];
+                        force[j][k] += c.force[k];
+                    }),
+                    None => broken[b] = true,
+                }
+            }
+            (0..3).for_each(|k| force[i][k] += fi[k]);
+        }
+        let newly = pair_pass(&sim.model, &mut sim.particles, &mut sim.bonds);
+        assert_eq!(sim.bonds.broken, broken, "pass {t}: broken flags differ");
+        assert_eq!(newly, broken.iter().filter(|&&b| b).count() - before);
+        let bits = |h: &[pdq::models::concrete::PlasticStretch]| {
+            h.iter()
+                .map(|h| h.plastic_stretch.to_bits())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(
+            bits(&sim.bonds.history),
+            bits(&history),
+            "pass {t}: history"
+        );
+        for (i, f) in force.iter().enumerate() {
+            let g = sim.particles.force[i].force;
+            assert!(
+                g.iter().zip(f).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "pass {t}, particle {i}: {g:?} against {f:?}"
+            );
+        }
+        passes_with_breaks += usize::from(newly > 0);
+        yielded |= history.iter().any(|h| h.plastic_stretch != 0.0);
+    }
+    let broken = sim.bonds.broken.iter().filter(|&&b| b).count();
+    assert!(
+        passes_with_breaks >= 3 && broken > 100 && yielded,
+        "the block must crack and the bar yield during the compared passes: {passes_with_breaks} passes broke bonds, {broken} broken, yielded {yielded}"
+    );
+}

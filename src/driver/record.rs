@@ -531,6 +531,7 @@ pub(crate) fn finish<M: Model>(
         last_step_converged: tally.solved.is_none_or(|r| r.converged),
         stopped_at_broken: tally.stopped_at_broken,
         stopped_at_probe: tally.stopped_at_probe,
+        stopped_below_peak: tally.stopped_below_peak,
     }))
 }
 

@@ -62,18 +62,24 @@ pub struct Summary {
     /// The run ended before its last step because this probe's displacement passed its
     /// `stop_beyond`.
     pub stopped_at_probe: Option<String>,
+    /// The run ended before its last step because this history column fell below
+    /// `[time] stop_below_peak`'s fraction of its peak.
+    pub stopped_below_peak: Option<String>,
 }
 
 impl Summary {
     /// Whether the run's solve converged: `None` for an explicit run (nothing iterates),
     /// else whether every load step reached its tolerance. A run that stopped early (at
-    /// `stop_at_broken_bonds` or a probe's `stop_beyond`) may end inside its last load step,
+    /// `stop_at_broken_bonds`, a probe's `stop_beyond` or `stop_below_peak`) may end inside
+    /// its last load step,
     /// unconverged by design; every step before it must have converged.
     pub fn solve_converged(&self) -> Option<bool> {
         if self.load_steps == 0 {
             return None;
         }
-        let stopped = self.stopped_at_broken || self.stopped_at_probe.is_some();
+        let stopped = self.stopped_at_broken
+            || self.stopped_at_probe.is_some()
+            || self.stopped_below_peak.is_some();
         let earlier = self.load_steps - u64::from(!self.last_step_converged);
         let earlier_converged = self.converged_steps == earlier;
         Some(earlier_converged && (self.last_step_converged || stopped))
@@ -322,7 +328,7 @@ impl<M: Model> Prepared<'_, M> {
     }
 
     /// What the step loop needs to know about the run on `layout`.
-    fn plan(&self, layout: &Layout) -> Plan {
+    fn plan(&self, layout: &Layout) -> Result<Plan, String> {
         let setup = &self.setup;
         let facts = RunFacts {
             columns: columns(setup),
@@ -382,7 +388,7 @@ impl<M: Model> Prepared<'_, M> {
         let plans = crate::parallel::decomposition::cell_plans(&layout);
         let cube = parallel::build_cube(&self.setup, &layout, &plans, rank, Box::new(mpi));
         crate::parallel::comm_mpi::injected_failure(rank)?;
-        let mut p = self.plan(&layout);
+        let mut p = self.plan(&layout)?;
         // Every rank holds the whole scene here, but the output is the same as a per-rank
         // setup's: in parts on several ranks.
         p.in_parts = scene.output.in_parts(ranks, true);
@@ -411,7 +417,7 @@ impl<M: Model> Prepared<'_, M> {
         )?;
         self.say_static(opts.quiet);
         let cubes = parallel::thread_cubes(&self.setup, &layout);
-        let mut p = self.plan(&layout);
+        let mut p = self.plan(&layout)?;
         p.in_parts = scene.output.in_parts(cubes.len(), false);
         let (setup, start) = self.into_start();
         let start = start.as_ref();
@@ -547,6 +553,12 @@ pub(super) fn report(summary: &Summary, opts: &RunOptions, frames: bool) {
             summary.steps
         );
     }
+    if let Some(column) = &summary.stopped_below_peak {
+        eprintln!(
+            "stopped    at step {}: {column} fell below [time] stop_below_peak's fraction of its peak",
+            summary.steps
+        );
+    }
     eprintln!(
         "done       {} steps in {:.2} s; {} broken bonds",
         summary.steps, summary.seconds, summary.broken
@@ -624,9 +636,10 @@ pub(super) fn run_plan(
     opts: &RunOptions,
     dir: &std::path::Path,
     layout: &Layout,
-) -> Plan {
+) -> Result<Plan, String> {
     let out = &scene.output;
-    Plan {
+    let peak_stop = super::observers::peak_stop(scene, &facts.columns)?;
+    Ok(Plan {
         columns: facts.columns,
         dir: dir.to_path_buf(),
         steps: facts.steps,
@@ -642,6 +655,7 @@ pub(super) fn run_plan(
             .iter()
             .map(|p| (p.name.clone(), p.stop_beyond))
             .collect(),
+        peak_stop,
         layout: layout.describe(),
         first_step: facts.first_step,
         static_evaluations: facts.static_evaluations,
@@ -673,5 +687,5 @@ pub(super) fn run_plan(
         analyses: facts.analyses,
         deform: scene.deform.clone(),
         in_parts: false,
-    }
+    })
 }

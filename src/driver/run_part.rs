@@ -98,7 +98,7 @@ pub fn run_rank<M: Model>(
         solver: SolverChoice::Explicit,
         scene_hash,
     };
-    let mut plan = run_plan(facts, scene, opts, &dir, &parts.layout);
+    let mut plan = run_plan(facts, scene, opts, &dir, &parts.layout)?;
     plan.in_parts = in_parts;
     ps.cube.sim.timing.add(
         crate::engine::timing::Phase::Setup,

@@ -28,6 +28,8 @@ pub(crate) struct Plan {
     pub stop_at_broken: u64,
     /// Each probe's name and `stop_beyond` (infinite when not given), in deck order.
     pub probe_stops: Vec<(String, f64)>,
+    /// `[time] stop_below_peak`, with its column's index in `columns`.
+    pub peak_stop: Option<(usize, crate::input::deck::PeakStop)>,
     pub layout: String,
     /// The step the loop starts from: 0, or the step of the checkpoint it resumes.
     pub first_step: u64,
@@ -134,6 +136,8 @@ pub(crate) struct Tally {
     pub shuffles: u64,
     pub stopped_at_broken: bool,
     pub stopped_at_probe: Option<String>,
+    /// The column of `[time] stop_below_peak` that ended the run.
+    pub stopped_below_peak: Option<String>,
     pub interrupted: Option<PathBuf>,
     pub checkpoints: Vec<(PathBuf, u64, f64)>,
 }

@@ -565,10 +565,6 @@ fn check_store<M: Model>(
             && (max_partner < n || offsets.last() == Some(&0)),
         "bond list does not match the particle store"
     );
-    assert!(
-        M::BOND_LANES == 1 || <M::Bond as Attributes>::LEN == 0,
-        "a model with lanes keeps no bond history"
-    );
 }
 
 /// Four intact bonds of one owner, for a model with lanes.

@@ -150,11 +150,12 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     const FIXED_FROM_BONDS: bool = false;
     /// Whether the bond loops hand the model four intact bonds of a particle at a time
     /// ([`Model::pair_lanes`], [`crate::model::lanes`]): 1 (one bond per call) or
-    /// [`crate::model::lanes::LANES`]. Pays for a law with much arithmetic per bond written generic
-    /// over [`crate::model::lanes::Real`] (micropolar); a short law (PMB) gains nothing from it.
-    /// Results are the same either way (sums in bond order, no fused operations). Only for
-    /// models without bond history (`Bond` = `()`) and with at most
-    /// [`crate::model::lanes::MAX_COMPONENTS`] generalized forces.
+    /// [`crate::model::lanes::LANES`]. The law is written once, generic over
+    /// [`crate::model::lanes::Real`] (PMB, LPS, micropolar, concrete), so results are the same
+    /// either way (sums in bond order, no fused operations). For models with at most
+    /// [`crate::model::lanes::MAX_COMPONENTS`] generalized forces. `pair_lanes` sees no bond
+    /// history: a model that keeps some (`Bond` ≠ `()`) refuses every group whose law would
+    /// read or change it (concrete: a steel bond's plastic stretch), and those go to `pair`.
     const BOND_LANES: usize = 1;
     /// The LAMMPS pair style of the same law (`"peri/pmb"`), which `pdq bench --peer` runs on
     /// the benchmark scene; `None`: LAMMPS has none.
@@ -323,8 +324,9 @@ pub trait Model: Sized + Clone + Send + Sync + 'static {
     ) -> Option<(Self::Force, Self::Force)>;
 
     /// [`Model::pair`] of four intact bonds of particle `i` at once (lane `l`: partner `j[l]`,
-    /// law `law[l]`), for models with `BOND_LANES` = 4, which keep no bond history. `None`
-    /// when any of the four breaks now: the engine then calls `pair` on each. The forces come
+    /// law `law[l]`), for models with `BOND_LANES` = 4; it sees no bond history, so it must
+    /// refuse a group whose history `pair` would read or change. `None` when it refuses the
+    /// group or any of the four breaks now: the engine then calls `pair` on each. The forces come
     /// component by component ([`crate::model::lanes::LaneForces`]) and must be those of `pair` bit
     /// for bit.
     fn pair_lanes(

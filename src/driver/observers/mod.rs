@@ -10,6 +10,8 @@ mod frames;
 mod history;
 mod stops;
 
+pub(crate) use history::peak_stop;
+
 use super::record::{gather_frame, FrameStore};
 use super::step_loop::{Plan, Tally};
 use crate::model::Model;

@@ -35,8 +35,8 @@ pub use super::materials::MaterialLines;
 pub use spec::{
     AnalysisKind, AnalysisSpec, BarSpec, BoundarySpec, Colouring, CriticalStep, DeformSpec,
     Equilibrium, InitialSpec, LoadKind, LoadSpec, Located, ModelLines, OutputSpec, ParallelSpec,
-    ProbeSpec, Region, RunLength, Scene, SolverSpec, ThermostatKind, ThermostatSpec, TimeSpec,
-    VelocitySpec,
+    PeakStop, ProbeSpec, Region, RunLength, Scene, SolverSpec, ThermostatKind, ThermostatSpec,
+    TimeSpec, VelocitySpec,
 };
 pub use time::DEFAULT_KRYLOV_ITERATIONS;
 

@@ -189,6 +189,15 @@ pub(super) struct TimeSection {
     pub(super) force_dt: Option<bool>,
     pub(super) integrator: Option<String>,
     pub(super) stop_at_broken_bonds: Option<i64>,
+    pub(super) stop_below_peak: Option<PeakStopSection>,
+}
+
+/// `[time] stop_below_peak = { column = "…", fraction = … }`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct PeakStopSection {
+    pub(super) column: String,
+    pub(super) fraction: f64,
 }
 
 #[derive(Deserialize)]

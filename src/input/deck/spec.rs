@@ -77,6 +77,19 @@ pub struct TimeSpec {
     /// End the run after the first step (load step) at which at least this many bonds have
     /// broken; 0 = run to the end.
     pub stop_at_broken_bonds: u64,
+    /// End the run at the first history row where a column has fallen below a fraction of
+    /// its peak (`[time] stop_below_peak`): a displacement-controlled test past its peak.
+    pub stop_below_peak: Option<PeakStop>,
+}
+
+/// `[time] stop_below_peak`: the run ends at the first history row at which |`column`| is below
+/// `fraction` × the largest |`column`| of the rows before it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PeakStop {
+    /// A history.csv column (`reaction_right_grip_x`, `load_load`, `tip_uz`, …).
+    pub column: String,
+    /// In (0, 1).
+    pub fraction: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]

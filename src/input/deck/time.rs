@@ -3,7 +3,7 @@
 
 use super::convert::{Converter, R};
 use super::sections::{SolverSection, TimeSection};
-use super::spec::{CriticalStep, Equilibrium, Located, RunLength, SolverSpec, TimeSpec};
+use super::spec::{CriticalStep, Equilibrium, Located, PeakStop, RunLength, SolverSpec, TimeSpec};
 use crate::engine::simulation::Integrator;
 use toml::Spanned;
 
@@ -66,6 +66,24 @@ impl Converter {
                 )
             }
         };
+        let stop_below_peak = match t.stop_below_peak {
+            None => None,
+            Some(p) if p.fraction > 0.0 && p.fraction < 1.0 && !p.column.is_empty() => {
+                Some(PeakStop {
+                    column: p.column,
+                    fraction: p.fraction,
+                })
+            }
+            Some(p) => {
+                return self.err(
+                    line,
+                    format!(
+                        "[time] stop_below_peak needs a history column and a fraction in (0, 1) (got column '{}', fraction {})",
+                        p.column, p.fraction
+                    ),
+                )
+            }
+        };
         let name = t.integrator.as_deref().unwrap_or("verlet");
         let Some(integrator) = Integrator::from_name(name) else {
             return self.err(
@@ -83,6 +101,7 @@ impl Converter {
             force_dt: t.force_dt.unwrap_or(false),
             integrator,
             stop_at_broken_bonds,
+            stop_below_peak,
         })
     }
 
