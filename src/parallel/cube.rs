@@ -347,10 +347,18 @@ impl<M: Model> Cube<M> {
         let n = self.sim.particles.len();
         let mut broken = vec![0.0f64; n];
         let b = &self.sim.bonds;
-        for (i, j, k) in b.iter() {
-            if b.broken[k] {
+        let (offsets, partners) = (b.offsets(), b.partners());
+        // A scan of each family's flags, and the counting only where one is set: called at
+        // every history row, this was a fifth of a cracking run's time as a loop over all bonds.
+        for (i, w) in offsets.windows(2).enumerate() {
+            let (start, end) = (w[0] as usize, w[1] as usize);
+            let flags = &b.broken[start..end];
+            if !flags.contains(&true) {
+                continue;
+            }
+            for (k, _) in flags.iter().enumerate().filter(|(_, &f)| f) {
                 broken[i] += 1.0;
-                broken[j] += 1.0;
+                broken[partners[start + k] as usize] += 1.0;
             }
         }
         self.wall.reverse(&mut broken, |a, b| *a += b);
