@@ -537,7 +537,7 @@ fn ends_check<M: Model, St: States<M::State>, B: Attributes>(
     ];
     let n = ends.x0.len();
     let offsets = bonds.offsets();
-    check_store::<M>(
+    check_store(
         ends.n_owned,
         n,
         &lengths,
@@ -549,7 +549,7 @@ fn ends_check<M: Model, St: States<M::State>, B: Attributes>(
 
 /// The bond list and the particle store must agree: this is what makes the unchecked partner
 /// access of [`sweep`] sound.
-fn check_store<M: Model>(
+fn check_store(
     n_owned: usize,
     n: usize,
     lengths: &[usize],
