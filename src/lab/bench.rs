@@ -19,7 +19,7 @@ mod voids;
 pub mod yardstick;
 
 use peer::{peer, peer_style};
-use ranks::ranks_line;
+use ranks::ranks_lines;
 #[cfg(feature = "mpi")]
 use ranks::MpiVisit;
 use savings::savings;
@@ -229,9 +229,7 @@ fn run_one(opts: &BenchOptions) -> Result<String, String> {
     }
     let (mut out, ours) =
         setup::with_model(&scene, Visit(&scene, opts)).map_err(|e| e.to_string())??;
-    for &r in &opts.ranks {
-        out.push_str(&ranks_line(opts, r)?);
-    }
+    out.push_str(&ranks_lines(opts)?);
     if opts.peer {
         out.push_str(&peer_lines(opts, &ours)?);
     }

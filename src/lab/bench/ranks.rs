@@ -1,14 +1,16 @@
 //! `pdq bench --ranks`: the standard scene under `mpirun`, one procCube per rank.
 
-use super::BenchOptions;
+use super::{bench_name, field, median, BenchOptions};
 #[cfg(feature = "mpi")]
-use super::{bench_name, bytes_of, line};
+use super::{bytes_of, line};
 #[cfg(feature = "mpi")]
 use crate::input::{deck, setup};
 #[cfg(feature = "mpi")]
 use crate::model::{Model, ModelVisitor};
 #[cfg(feature = "mpi")]
 use crate::parallel::{self, decomposition::Procs};
+use std::collections::BTreeMap;
+use std::fmt::Write;
 use std::process::Command;
 
 /// Under `mpirun`: this rank's procCube of the standard scene; rank 0 prints the line.
@@ -58,8 +60,62 @@ pub(super) fn mpirun(ranks: usize) -> Command {
     c
 }
 
+/// The rank counts of `--ranks`, `--rounds` times through, alternating as the thread counts
+/// do: each run's line (with its speed-up over the one-rank run of the same round), then,
+/// with more than one round, the medians per rank count.
+pub(super) fn ranks_lines(opts: &BenchOptions) -> Result<String, String> {
+    let mut out = String::new();
+    let mut per_count: BTreeMap<usize, (Vec<f64>, Vec<f64>)> = BTreeMap::new();
+    for _ in 0..opts.rounds.max(1) {
+        let mut one_rank = None;
+        for &ranks in &opts.ranks {
+            let line = ranks_line(opts, ranks)?;
+            let us = line
+                .lines()
+                .find_map(|l| field(l, "us_per_particle_step")?.parse::<f64>().ok());
+            let Some(us) = us else {
+                out.push_str(&line);
+                continue;
+            };
+            let entry = per_count.entry(ranks).or_default();
+            entry.0.push(us);
+            let speedup = match one_rank {
+                _ if ranks == 1 => {
+                    one_rank = Some(us);
+                    None
+                }
+                Some(base) => Some(base / us),
+                None => None,
+            };
+            match speedup {
+                Some(s) => {
+                    entry.1.push(s);
+                    let _ = writeln!(out, "{} speedup={s:.2}", line.trim_end());
+                }
+                None => out.push_str(&line),
+            }
+        }
+    }
+    if opts.rounds > 1 {
+        for (ranks, (us, speedups)) in &per_count {
+            let _ = write!(
+                out,
+                "bench median model={} threads=1 ranks={ranks} runs={} us_per_particle_step={:.4}",
+                bench_name(opts),
+                us.len(),
+                median(us.clone())
+            );
+            if !speedups.is_empty() {
+                let _ = write!(out, " speedup={:.2}", median(speedups.clone()));
+            }
+            let _ = writeln!(out);
+        }
+    }
+    Ok(out)
+}
+
 /// Runs this program's bench under `mpirun -np ranks` and returns its line.
-pub(super) fn ranks_line(opts: &BenchOptions, ranks: usize) -> Result<String, String> {
+fn ranks_line(opts: &BenchOptions, ranks: usize) -> Result<String, String> {
     if !cfg!(feature = "mpi") {
         return Ok(format!(
             "bench ranks={ranks} skipped: this pdq was built without the 'mpi' feature (cargo build --release --features mpi)\n"
