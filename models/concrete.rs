@@ -11,8 +11,8 @@
 //! Two different concrete (or steel) materials bond with the series stiffness and the tighter
 //! limits.
 
-use super::pmb::lane_positions;
-use crate::model::lanes::{LaneForces, Real, F4, LANES, MAX_COMPONENTS};
+use super::pmb::{elongation, lane_positions};
+use crate::model::lanes::{LaneForces, Real, F4, LANES};
 use crate::model::{
     bond_based_lame, check_options, stretch, BondGeom, Dimension, Material, MaterialKind, Model,
     ModelBuild, ModelError, PairTable, Sample, SampleOf, Side,
@@ -104,13 +104,6 @@ impl Concrete {
         };
         Some([a, b, c, d])
     }
-}
-
-/// The bond's length r and elongation e = r − L (bond vector `y`), on one bond or four.
-#[inline(always)]
-fn elongation<T: Real>(y: &[T; 3], length: T) -> (T, T) {
-    let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
-    (r - length, r)
 }
 
 /// The force on end i per unit bond vector, from c × the elastic elongation `ce`:
@@ -288,11 +281,7 @@ impl Model for Concrete {
             length,
             r,
         );
-        let mut i = [F4::splat(0.0); MAX_COMPONENTS];
-        for k in 0..3 {
-            i[k] = f * y[k];
-        }
-        Some(LaneForces::opposite(i))
+        Some(LaneForces::central(f, &y))
     }
 
     fn energy(

@@ -425,11 +425,7 @@ impl Model for Lps {
             F4::gather(|k| geom[k].beta),
             [F4::splat(i.volume), F4::gather(|k| j[k].volume)],
         );
-        let mut i = [F4::splat(0.0); MAX_COMPONENTS];
-        for c in 0..3 {
-            i[c] = f * y[c];
-        }
-        Some(LaneForces::opposite(i))
+        Some(LaneForces::central(f, &y))
     }
 
     fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {

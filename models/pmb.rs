@@ -6,7 +6,7 @@
 //! and the smaller critical stretch.
 
 use crate::model::attributes::Attributes;
-use crate::model::lanes::{LaneForces, Real, F4, LANES, MAX_COMPONENTS};
+use crate::model::lanes::{LaneForces, Real, F4, LANES};
 use crate::model::{
     bond_based_lame, check_options, stretch, stretch_line, BondGeom, Dimension, Material, Model,
     ModelBuild, ModelError, PairTable, Sample, SampleOf, Side,
@@ -112,7 +112,7 @@ pub(crate) fn lane_positions<M: Model<Alter = Motion>>(
 /// The bond's elongation e = r − L and its length r (bond vector `y`), on one bond or four.
 /// Comparing e with s0·L and folding 1/L into 1/r leaves one division per bond.
 #[inline(always)]
-fn elongation<T: Real>(y: &[T; 3], length: T) -> (T, T) {
+pub(crate) fn elongation<T: Real>(y: &[T; 3], length: T) -> (T, T) {
     let r = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
     (r - length, r)
 }
@@ -250,11 +250,7 @@ impl Model for Pmb {
             length,
             r,
         );
-        let mut i = [F4::splat(0.0); MAX_COMPONENTS];
-        for k in 0..3 {
-            i[k] = f * y[k];
-        }
-        Some(LaneForces::opposite(i))
+        Some(LaneForces::central(f, &y))
     }
 
     fn energy(&self, law: &Law, i: &Side<Self>, j: &Side<Self>, geom: &BondGeom, _: &()) -> f64 {

@@ -527,6 +527,23 @@ fn the_same_deck_gives_bit_identical_results() {
 /// which a bond breaks now and the ends of lists go one bond at a time. Through a crack that
 /// opens step by step (bonds breaking in the very passes compared), its forces and broken flags
 /// are those of the PMB loop written by hand one bond at a time, bit for bit.
+/// The lane-sweep tests' crack: the halves x < 6 mm and x ≥ 6 mm pulled apart by `a` each,
+/// sheared and squeezed across in proportion, so that each pass opens it further.
+fn open_crack<M: pdq::model::Model<Alter = pdq::models::pmb::Motion>>(
+    p: &mut pdq::engine::particles::Particles<M>,
+    a: f64,
+) {
+    for i in 0..p.len() {
+        let x0 = p.x0[i];
+        let side = if x0[0] < 6e-3 { -1.0 } else { 1.0 };
+        p.alter[i].pos = [
+            x0[0] + side * a,
+            x0[1] + 0.3 * a * x0[2] / 4e-3,
+            x0[2] - 0.2 * side * a,
+        ];
+    }
+}
+
 #[test]
 fn the_lane_sweep_gives_the_one_bond_forces_and_breaks() {
     use pdq::engine::forces::pair_pass;
@@ -537,17 +554,7 @@ fn the_lane_sweep_gives_the_one_bond_forces_and_breaks() {
     let sim = &mut s.sim;
     let mut passes_with_breaks = 0;
     for t in 0..40 {
-        // The two halves pulled apart and sheared a little more at each pass.
-        for i in 0..sim.particles.len() {
-            let x0 = sim.particles.x0[i];
-            let side = if x0[0] < 6e-3 { -1.0 } else { 1.0 };
-            let a = 1e-7 * t as f64;
-            sim.particles.alter[i].pos = [
-                x0[0] + side * a,
-                x0[1] + 0.3 * a * x0[2] / 4e-3,
-                x0[2] - 0.2 * side * a,
-            ];
-        }
+        open_crack(&mut sim.particles, 1e-7 * t as f64);
         let mut hand_broken = sim.bonds.broken.clone();
         let before = hand_broken.iter().filter(|&&b| b).count();
         let mut hand_force = vec![[0.0f64; 3]; sim.particles.len()];
@@ -631,17 +638,7 @@ progress = false
     let sim = &mut s.sim;
     let (mut passes_with_breaks, mut yielded) = (0, false);
     for t in 0..40 {
-        // The two halves pulled apart and squeezed across a little more at each pass.
-        for i in 0..sim.particles.len() {
-            let x0 = sim.particles.x0[i];
-            let side = if x0[0] < 6e-3 { -1.0 } else { 1.0 };
-            let a = 2e-7 * t as f64;
-            sim.particles.alter[i].pos = [
-                x0[0] + side * a,
-                x0[1] + 0.3 * a * x0[2] / 4e-3,
-                x0[2] - 0.2 * side * a,
-            ];
-        }
+        open_crack(&mut sim.particles, 2e-7 * t as f64);
         let (mut broken, mut history) = (sim.bonds.broken.clone(), sim.bonds.history.clone());
         let before = broken.iter().filter(|&&b| b).count();
         let mut force = vec![[0.0f64; 3]; sim.particles.len()];

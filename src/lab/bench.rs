@@ -155,6 +155,27 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// One `bench median` line per worker count (`count`: `threads=2`, `threads=1 ranks=2`): the
+/// median of its runs' µs per particle-step and of their paired speed-ups, if any.
+fn median_lines<'a>(
+    out: &mut String,
+    name: &str,
+    counts: impl Iterator<Item = (String, &'a (Vec<f64>, Vec<f64>))>,
+) {
+    for (count, (us, speedups)) in counts {
+        let _ = write!(
+            out,
+            "bench median model={name} {count} runs={} us_per_particle_step={:.4}",
+            us.len(),
+            median(us.clone())
+        );
+        if !speedups.is_empty() {
+            let _ = write!(out, " speedup={:.2}", median(speedups.clone()));
+        }
+        let _ = writeln!(out);
+    }
+}
+
 /// Runs the benchmark and returns the lines it printed. `--model all` runs every model with a
 /// benchmark solid (the LAMMPS peer for those that have one) and ends with a Markdown table.
 pub fn run(opts: &BenchOptions) -> Result<String, String> {
@@ -487,19 +508,8 @@ fn bench_setup<M: Model>(
         }
     }
     if rounds > 1 {
-        for (threads, (us, speedups)) in &per_count {
-            let _ = write!(
-                out,
-                "bench median model={} threads={threads} runs={} us_per_particle_step={:.4}",
-                bench_name(opts),
-                us.len(),
-                median(us.clone())
-            );
-            if !speedups.is_empty() {
-                let _ = write!(out, " speedup={:.2}", median(speedups.clone()));
-            }
-            let _ = writeln!(out);
-        }
+        let counts = per_count.iter().map(|(t, r)| (format!("threads={t}"), r));
+        median_lines(&mut out, bench_name(opts), counts);
     }
     let ours: Medians = per_count
         .iter()

@@ -74,6 +74,17 @@ impl LaneForces {
             opposite: true,
         }
     }
+
+    /// The central forces of four bonds: `f`·`y` on each owner (y the bond vector, f the
+    /// force per unit of it) and its negative on each partner.
+    #[inline(always)]
+    pub fn central(f: F4, y: &[F4; 3]) -> LaneForces {
+        let mut i = [F4::splat(0.0); MAX_COMPONENTS];
+        for (c, yc) in i.iter_mut().zip(y) {
+            *c = f * *yc;
+        }
+        LaneForces::opposite(i)
+    }
 }
 
 /// Methods both forms of `F4` build from their `load`, `store`, `gather` and `transpose`.

@@ -1,6 +1,6 @@
 //! `pdq bench --ranks`: the standard scene under `mpirun`, one procCube per rank.
 
-use super::{bench_name, field, median, BenchOptions};
+use super::{bench_name, field, median_lines, BenchOptions};
 #[cfg(feature = "mpi")]
 use super::{bytes_of, line};
 #[cfg(feature = "mpi")]
@@ -97,19 +97,10 @@ pub(super) fn ranks_lines(opts: &BenchOptions) -> Result<String, String> {
         }
     }
     if opts.rounds > 1 {
-        for (ranks, (us, speedups)) in &per_count {
-            let _ = write!(
-                out,
-                "bench median model={} threads=1 ranks={ranks} runs={} us_per_particle_step={:.4}",
-                bench_name(opts),
-                us.len(),
-                median(us.clone())
-            );
-            if !speedups.is_empty() {
-                let _ = write!(out, " speedup={:.2}", median(speedups.clone()));
-            }
-            let _ = writeln!(out);
-        }
+        let counts = per_count
+            .iter()
+            .map(|(r, runs)| (format!("threads=1 ranks={r}"), runs));
+        median_lines(&mut out, bench_name(opts), counts);
     }
     Ok(out)
 }
